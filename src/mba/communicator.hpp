@@ -1,0 +1,132 @@
+// bsplineMorph: OpenFOAM-free multilevel B-spline core
+// The small communication interface the distributed algorithm is written against.
+//
+// Implementations provide rank/size and two byte-level collectives; typed
+// helpers, reductions (summed in rank order, so every rank gets bitwise the
+// same result) and the collective check are built on them here, once.
+#ifndef MBA_COMMUNICATOR_HPP
+#define MBA_COMMUNICATOR_HPP
+
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace mba {
+
+using bytes = std::vector<char>;
+
+/// Thrown on every rank when a collective check fails on any rank
+struct collectiveError : std::runtime_error
+{
+    using std::runtime_error::runtime_error;
+};
+
+/// Traffic counters (point-to-point payload; collectives counted separately)
+struct trafficStats
+{
+    std::uint64_t messagesSent = 0, bytesSent = 0;
+    std::uint64_t messagesReceived = 0, bytesReceived = 0;
+    std::uint64_t collectiveBytes = 0;   ///< bytes this rank contributed to all-gathers
+};
+
+class communicator
+{
+    mutable trafficStats traffic_;
+
+protected:
+    /// Every rank receives every rank's buffer (index = rank)
+    virtual std::vector<bytes> allGatherBytes(const bytes& mine) const = 0;
+    /// send[r] goes to rank r (empty: no message); returns what rank r sent here
+    virtual std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const = 0;
+
+public:
+    virtual ~communicator() = default;
+    virtual int rank() const = 0;
+    virtual int size() const = 0;
+
+    const trafficStats& traffic() const { return traffic_; }
+
+    template <class T>
+    std::vector<std::vector<T>> allGather(const std::vector<T>& mine) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        bytes b(mine.size()*sizeof(T));
+        if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
+        traffic_.collectiveBytes += b.size();
+        const std::vector<bytes> all = allGatherBytes(b);
+        std::vector<std::vector<T>> out(all.size());
+        for (std::size_t r = 0; r < all.size(); ++r) out[r] = fromBytes<T>(all[r]);
+        return out;
+    }
+
+    template <class T>
+    std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        std::vector<bytes> b(size());
+        for (int r = 0; r < size(); ++r)
+        {
+            if (r >= int(send.size()) || send[r].empty()) continue;
+            b[r].resize(send[r].size()*sizeof(T));
+            std::memcpy(b[r].data(), send[r].data(), b[r].size());
+            if (r != rank()) { ++traffic_.messagesSent; traffic_.bytesSent += b[r].size(); }
+        }
+        const std::vector<bytes> got = exchangeBytes(b);
+        std::vector<std::vector<T>> out(got.size());
+        for (std::size_t r = 0; r < got.size(); ++r)
+        {
+            if (!got[r].empty() && int(r) != rank())
+            {
+                ++traffic_.messagesReceived;
+                traffic_.bytesReceived += got[r].size();
+            }
+            out[r] = fromBytes<T>(got[r]);
+        }
+        return out;
+    }
+
+    /// Element-wise sum over ranks, added in rank order: identical on every rank
+    std::vector<double> sum(const std::vector<double>& mine) const;
+    double sum(double x) const { return sum(std::vector<double>{x})[0]; }
+    double max(double x) const;
+    double min(double x) const { return -max(-x); }
+    std::int64_t sum(std::int64_t x) const;
+
+    /// Collective check: when ok is false on any rank, every rank throws
+    /// collectiveError with the message of the lowest failing rank
+    void check(bool ok, const std::string& msg) const;
+
+private:
+    template <class T>
+    static std::vector<T> fromBytes(const bytes& b)
+    {
+        std::vector<T> v(b.size()/sizeof(T));
+        if (!v.empty()) std::memcpy(v.data(), b.data(), v.size()*sizeof(T));
+        return v;
+    }
+};
+
+/// One process, one rank
+class serialCommunicator : public communicator
+{
+protected:
+    std::vector<bytes> allGatherBytes(const bytes& mine) const override { return {mine}; }
+    std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const override { return send; }
+
+public:
+    int rank() const override { return 0; }
+    int size() const override { return 1; }
+};
+
+/// Run body on n simulated ranks (threads of this process), each with its own
+/// communicator. Exceptions are rethrown after all ranks finished (the lowest
+/// rank's first); a rank that dies makes the others' next collective throw
+/// instead of waiting forever.
+void runSimulated(int n, const std::function<void(const communicator&)>& body);
+
+} // namespace mba
+#endif

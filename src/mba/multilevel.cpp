@@ -1,0 +1,697 @@
+#include "multilevel.hpp"
+#include "buckets.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace mba {
+
+void params::validate() const
+{
+    precondition(std::isfinite(tolerance) && tolerance >= 0,
+        "mba: tolerance must be a finite number >= 0, got " + std::to_string(tolerance));
+    precondition(maxLevels >= 1 && maxLevels <= 30,
+        "mba: maxLevels must be in [1, 30], got " + std::to_string(maxLevels));
+    precondition(initialGrid >= 1 && initialGrid <= (1 << 20),
+        "mba: initialGrid must be in [1, 2^20], got " + std::to_string(initialGrid));
+    precondition(std::isfinite(padding) && padding > 0 && padding <= 1,
+        "mba: padding must be in (0, 1], got " + std::to_string(padding));
+    precondition(bucketTiles >= 1, "mba: bucketTiles must be >= 1, got " + std::to_string(bucketTiles));
+}
+
+namespace {
+
+double now()
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// Runs f; an std::invalid_argument on any rank becomes the same error on all
+template <class F>
+void collectively(const communicator& comm, F&& f)
+{
+    std::string err;
+    try { f(); }
+    catch (const std::invalid_argument& e) { err = e.what(); }
+    comm.check(err.empty(), err);
+}
+
+template <int D>
+point<D> scaled(point<D> u, double s)
+{
+    for (auto& x : u) x *= s;
+    return u;
+}
+
+} // namespace
+
+template <int D>
+struct multilevel<D>::level
+{
+    static constexpr int npt = tileLayout<D>::nodesPerTile;
+    int k = 0;
+    double scale = 1;               ///< 2^k: u_k = u_0*scale
+    tileLayout<D> own, view;
+    bool ownIsView = false;         ///< serial, sparse: own tiles are the view (own left empty)
+    std::vector<double> phi, omega; ///< view data
+    std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< own tile ids / view tile ids per rank
+    std::vector<std::int64_t> ownToView; ///< empty when ownIsView
+    levelStats stats;
+
+    const tileLayout<D>& ownTiles() const { return ownIsView ? view : own; }
+    std::int64_t toView(std::int64_t id) const { return ownIsView ? id : ownToView[id]; }
+};
+
+namespace {
+
+/// Morton code of a point's level-0 local coordinates on a 2^(63/D) grid
+template <int D>
+std::uint64_t morton(const point<D>& u, const domain<D>& dom)
+{
+    constexpr int bits = 63/D;
+    std::uint64_t code = 0;
+    std::uint64_t q[D];
+    for (int d = 0; d < D; ++d)
+    {
+        const double f = u[d]/double(dom.n0[d]);
+        q[d] = std::uint64_t(std::min(std::max(f, 0.0), 1.0 - 1e-16)*double(std::uint64_t(1) << bits));
+    }
+    for (int b = bits - 1; b >= 0; --b)
+        for (int d = 0; d < D; ++d) code = (code << 1) | ((q[d] >> b) & 1u);
+    return code;
+}
+
+/// Indices of the selected points in Morton order (locality for the lattices)
+template <int D>
+std::vector<std::uint32_t> spatialOrder(pointsView<D> x, const domain<D>& dom, const std::vector<std::uint8_t>* select)
+{
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> key;
+    key.reserve(x.size);
+    for (std::size_t i = 0; i < x.size; ++i)
+        if (!select || (*select)[i]) key.emplace_back(morton<D>(dom.local0(x[i]), dom), std::uint32_t(i));
+    std::sort(key.begin(), key.end());
+    std::vector<std::uint32_t> order(key.size());
+    for (std::size_t i = 0; i < key.size(); ++i) order[i] = key[i].second;
+    return order;
+}
+
+} // namespace
+
+template <int D>
+multilevel<D>::multilevel(const communicator& comm, const params& p, int nComponents,
+                          pointsView<D> control, std::vector<std::uint8_t> mask,
+                          pointsView<D> evaluation, const box<D>* bounds)
+:
+    comm_(comm), p_(p), nc_(nComponents), nw_(1), ctrl_(control), eval_(evaluation), mask_(std::move(mask))
+{
+    collectively(comm_, [&] {
+        p_.validate();
+        precondition(nc_ >= 1 && nc_ <= 3, "mba: 1 to 3 value components, got " + std::to_string(nc_));
+        precondition(mask_.empty() || mask_.size() == ctrl_.size*nc_,
+            "mba: the mask has " + std::to_string(mask_.size()) + " entries, expected "
+            + std::to_string(ctrl_.size*nc_) + " (control points x components)");
+        for (std::size_t i = 0; i < ctrl_.size; ++i)
+            for (int d = 0; d < D; ++d)
+                precondition(std::isfinite(ctrl_[i][d]),
+                    "mba: control point " + std::to_string(i) + " has a non-finite coordinate");
+        for (std::size_t i = 0; i < eval_.size; ++i)
+            for (int d = 0; d < D; ++d)
+                precondition(std::isfinite(eval_[i][d]),
+                    "mba: evaluation point " + std::to_string(i) + " has a non-finite coordinate");
+    });
+
+    // Which points constrain anything; whether masks differ between components
+    active_.assign(ctrl_.size, 1);
+    bool mixed = false;
+    if (!mask_.empty())
+    {
+        for (std::size_t i = 0; i < ctrl_.size; ++i)
+        {
+            int on = 0;
+            for (int c = 0; c < nc_; ++c) on += mask_[i*nc_ + c] != 0;
+            active_[i] = on > 0;
+            mixed = mixed || (on > 0 && on < nc_);
+        }
+    }
+    nw_ = comm_.max(mixed ? 1.0 : 0.0) > 0 ? nc_ : 1;
+    std::int64_t nActive = 0;
+    for (auto a : active_) nActive += a;
+    nCtrlGlobal_ = comm_.sum(nActive);
+
+    // Domain: global bounding box, padded
+    box<D> b = box<D>::empty();
+    for (std::size_t i = 0; i < ctrl_.size; ++i) if (active_[i]) b.add(ctrl_[i]);
+    for (std::size_t i = 0; i < eval_.size; ++i) b.add(eval_[i]);
+    std::vector<double> mm(2*D);
+    for (int d = 0; d < D; ++d) { mm[d] = b.lo[d]; mm[D + d] = -b.hi[d]; }
+    for (const auto& v : comm_.allGather(mm))
+        for (int d = 0; d < D; ++d) { b.lo[d] = std::min(b.lo[d], v[d]); b.hi[d] = std::max(b.hi[d], -v[D + d]); }
+    if (bounds)
+    {
+        collectively(comm_, [&] {
+            for (int d = 0; d < D; ++d)
+                precondition(b.isEmpty() || (bounds->lo[d] <= b.lo[d] && b.hi[d] <= bounds->hi[d]),
+                    "mba: the given bounds do not contain all points");
+        });
+        b = *bounds;
+    }
+    collectively(comm_, [&] { dom_ = domain<D>::fromBox(b, p_.initialGrid, p_.padding); });
+    precondition(ctrl_.size < (std::size_t(1) << 32) && eval_.size < (std::size_t(1) << 32),
+        "mba: at most 2^32 points per rank");
+    ctrlOrder_ = spatialOrder<D>(ctrl_, dom_, &active_);
+    evalOrder_ = spatialOrder<D>(eval_, dom_, nullptr);
+
+    if (p_.affine)
+    {
+        point<D> centre;
+        double ext = 0;
+        for (int d = 0; d < D; ++d)
+        {
+            centre[d] = dom_.lo[d] + 0.5*dom_.n0[d]*dom_.h0;
+            ext = std::max(ext, dom_.n0[d]*dom_.h0);
+        }
+        affine_ = affineFit<D>(comm_, nc_, ctrl_, mask_, centre, 0.5*ext);
+    }
+
+    // Clusters of this rank's query points: which remote buckets it needs
+    if (comm_.size() > 1)
+    {
+        std::vector<const double*> q;
+        for (std::size_t i = 0; i < ctrl_.size; ++i) if (active_[i]) q.push_back(ctrl_[i]);
+        for (std::size_t i = 0; i < eval_.size; ++i) q.push_back(eval_[i]);
+        const std::int64_t leaf = std::max<std::int64_t>(64, std::int64_t(q.size())/512);
+        const auto groups = bisect<D>(std::int64_t(q.size()), [&](std::int64_t i) {
+            point<D> x;
+            for (int d = 0; d < D; ++d) x[d] = q[i][d];
+            return x;
+        }, leaf);
+        for (const auto& g : groups)
+        {
+            box<D> qb = box<D>::empty();
+            for (auto i : g) qb.add(q[i]);
+            queryBoxes_.push_back(qb);
+        }
+    }
+    residual_.assign(ctrl_.size*nc_, 0.0);
+}
+
+template <int D>
+multilevel<D>::~multilevel() = default;
+
+template <int D>
+template <class F>
+void multilevel<D>::forOwnStencils(const level& L, F&& f) const
+{
+    for (const std::uint32_t i : ctrlOrder_)
+    {
+        const point<D> u = scaled<D>(dom_.local0(ctrl_[i]), L.scale);
+        f(std::size_t(i), stencil<D>(u.data()));
+    }
+}
+
+template <int D>
+void multilevel<D>::buildLevel(int k)
+{
+    const double t0 = now();
+    constexpr int npt = level::npt;
+    const int P = comm_.size(), me = comm_.rank();
+    std::unique_ptr<level> Lp(new level);
+    level& L = *Lp;
+    L.k = k;
+    L.scale = std::ldexp(1.0, k);
+    index<D> nodes;
+    for (int d = 0; d < D; ++d) nodes[d] = dom_.nodes(k, d);
+    collectively(comm_, [&] { L.own.init(nodes, false); });
+
+    // This rank's tiles and partial omega
+    forOwnStencils(L, [&](std::size_t, const stencil<D>& st) {
+        insertStencil(L.own, st);
+    });
+    const std::int64_t nOwn = L.own.size();
+    std::vector<double> ownW(nOwn*npt*nw_, 0.0);
+    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+        forStencil(L.own, st, [&](std::int64_t id, int n, double w) {
+            double* o = &ownW[(id*npt + n)*nw_];
+            if (nw_ == 1) o[0] += w*w;
+            else for (int c = 0; c < nw_; ++c) if (mask_[i*nc_ + c]) o[c] += w*w;
+        });
+    });
+
+    // Buckets of own tiles, their index boxes all-gathered; requests for the
+    // remote buckets that meet this rank's query stencils
+    L.sendTiles.assign(P, {});
+    L.recvTiles.assign(P, {});
+    std::vector<std::vector<std::uint64_t>> keysGot(P);
+    std::vector<std::vector<double>> omegaGot(P);
+    if (P > 1)
+    {
+        const auto buckets = bisect<D>(nOwn, [&](std::int64_t id) {
+            const index<D> t = L.own.coord(L.own.keyOf(id));
+            std::array<double, D> x;
+            for (int d = 0; d < D; ++d) x[d] = double(t[d]);
+            return x;
+        }, p_.bucketTiles);
+        std::vector<std::int64_t> myBoxes;
+        for (const auto& g : buckets)
+        {
+            indexBox<D> bb;
+            bb.lo.fill(INT64_MAX);
+            bb.hi.fill(INT64_MIN);
+            for (auto id : g)
+            {
+                const index<D> t = L.own.coord(L.own.keyOf(id));
+                for (int d = 0; d < D; ++d) { bb.lo[d] = std::min(bb.lo[d], t[d]); bb.hi[d] = std::max(bb.hi[d], t[d]); }
+            }
+            myBoxes.insert(myBoxes.end(), bb.lo.begin(), bb.lo.end());
+            myBoxes.insert(myBoxes.end(), bb.hi.begin(), bb.hi.end());
+        }
+        L.stats.buckets = std::int64_t(buckets.size());
+        const auto allBoxes = comm_.allGather(myBoxes);
+
+        // Query stencils at this level, as tile boxes
+        std::vector<indexBox<D>> qt;
+        indexBox<D> all;
+        all.lo.fill(INT64_MAX);
+        all.hi.fill(INT64_MIN);
+        for (const auto& qb : queryBoxes_)
+        {
+            const point<D> ulo = scaled<D>(dom_.local0(qb.lo.data()), L.scale);
+            const point<D> uhi = scaled<D>(dom_.local0(qb.hi.data()), L.scale);
+            indexBox<D> t;
+            for (int d = 0; d < D; ++d)
+            {
+                t.lo[d] = std::int64_t(std::floor(ulo[d]))/tileEdge;
+                t.hi[d] = (std::int64_t(std::floor(uhi[d])) + 3)/tileEdge;
+                all.lo[d] = std::min(all.lo[d], t.lo[d]);
+                all.hi[d] = std::max(all.hi[d], t.hi[d]);
+            }
+            qt.push_back(t);
+        }
+        std::vector<std::vector<std::int64_t>> requests(P);
+        for (int r = 0; r < P; ++r)
+        {
+            if (r == me || qt.empty()) continue;
+            const auto& v = allBoxes[r];
+            for (std::size_t b = 0; b < v.size()/(2*D); ++b)
+            {
+                indexBox<D> rb;
+                for (int d = 0; d < D; ++d) { rb.lo[d] = v[2*D*b + d]; rb.hi[d] = v[2*D*b + D + d]; }
+                if (!rb.intersects(all)) continue;
+                for (const auto& t : qt)
+                    if (rb.intersects(t)) { requests[r].push_back(std::int64_t(b)); break; }
+            }
+        }
+        const auto wanted = comm_.exchange(requests);
+        std::vector<std::vector<std::uint64_t>> keys(P);
+        std::vector<std::vector<double>> om(P);
+        for (int r = 0; r < P; ++r)
+        {
+            for (auto b : wanted[r])
+            {
+                for (auto id : buckets.at(std::size_t(b)))
+                {
+                    L.sendTiles[r].push_back(id);
+                    keys[r].push_back(L.own.keyOf(id));
+                    om[r].insert(om[r].end(), ownW.begin() + id*npt*nw_, ownW.begin() + (id + 1)*npt*nw_);
+                }
+            }
+        }
+        keysGot = comm_.exchange(keys);
+        omegaGot = comm_.exchange(om);
+    }
+
+    // The view: own and received tiles, dense when that is not much larger
+    std::int64_t upper = nOwn;
+    for (const auto& kg : keysGot) upper += std::int64_t(kg.size());
+    std::int64_t denseTiles = 1;
+    for (int d = 0; d < D; ++d) denseTiles *= (nodes[d] + tileEdge - 1)/tileEdge;
+    const bool dense = denseTiles <= 2*upper + 64;
+    if (P == 1 && !dense)
+    {
+        // Serial and sparse: the own tiles and partial omega are the view
+        L.view = std::move(L.own);
+        L.own = tileLayout<D>();
+        L.ownIsView = true;
+        L.omega = std::move(ownW);
+    }
+    else
+    {
+        L.view.init(nodes, dense);
+        L.ownToView.resize(nOwn);
+        for (std::int64_t id = 0; id < nOwn; ++id) L.ownToView[id] = L.view.findOrInsertKey(L.own.keyOf(id));
+        for (int r = 0; r < P; ++r)
+            for (auto key : keysGot[r]) L.recvTiles[r].push_back(L.view.findOrInsertKey(key));
+
+        // omega: partial sums added in rank order
+        L.omega.assign(L.view.size()*npt*nw_, 0.0);
+        for (int r = 0; r < P; ++r)
+        {
+            if (r == me)
+            {
+                for (std::int64_t id = 0; id < nOwn; ++id)
+                    for (int j = 0; j < npt*nw_; ++j) L.omega[L.ownToView[id]*npt*nw_ + j] += ownW[id*npt*nw_ + j];
+            }
+            else
+            {
+                const auto& og = omegaGot[r];
+                for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t)
+                    for (int j = 0; j < npt*nw_; ++j) L.omega[L.recvTiles[r][t]*npt*nw_ + j] += og[t*npt*nw_ + j];
+            }
+        }
+    }
+    L.phi.assign(L.view.size()*npt*nc_, 0.0);
+
+    levelStats& s = L.stats;
+    s.level = k;
+    s.h = dom_.h0/L.scale;
+    s.ownTiles = L.ownTiles().size();
+    s.viewTiles = L.view.size();
+    s.dense = L.view.dense();
+    s.nodes = L.view.size()*npt;
+    s.bytes = std::int64_t((L.phi.capacity() + L.omega.capacity())*sizeof(double)
+        + L.own.bytes() + L.view.bytes() + L.ownToView.capacity()*sizeof(std::int64_t));
+    for (int r = 0; r < P; ++r)
+    {
+        s.tilesSent += std::int64_t(L.sendTiles[r].size());
+        s.tilesReceived += std::int64_t(L.recvTiles[r].size());
+        s.messagesSent += !L.sendTiles[r].empty();
+        s.messagesReceived += !L.recvTiles[r].empty();
+    }
+    s.bytesSentPerApply = s.tilesSent*npt*nc_*std::int64_t(sizeof(double));
+    s.bytesReceivedPerApply = s.tilesReceived*npt*nc_*std::int64_t(sizeof(double));
+    s.planSeconds = now() - t0;
+    levels_.push_back(std::move(Lp));
+}
+
+template <int D>
+void multilevel<D>::applyLevel(level& L)
+{
+    constexpr int npt = level::npt;
+    const int P = comm_.size(), me = comm_.rank();
+    const std::int64_t nOwn = L.ownTiles().size();
+    const int blk = npt*nc_;
+    // Serial: delta accumulates straight into the view; parallel: into own
+    // partial sums, which are then added to the received ones in rank order
+    const bool direct = P == 1;
+    double* delta;
+    std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    if (direct) delta = L.phi.data();
+    else
+    {
+        const std::size_t nd = std::size_t(nOwn)*blk;
+        if (scratch_.size() < nd) scratch_.resize(nd);
+        std::fill(scratch_.begin(), scratch_.begin() + nd, 0.0);
+        delta = scratch_.data();
+    }
+
+    // delta += w^2 phi_c = w^3 r_c / sum(w^2)
+    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+        const double sw = st.sumSquares();
+        double rr[3];
+        for (int c = 0; c < nc_; ++c)
+            rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
+        forStencil(L.ownTiles(), st, [&](std::int64_t id, int n, double w) {
+            const double w3 = w*w*w;
+            double* dl = delta + ((direct ? L.toView(id) : id)*npt + n)*nc_;
+            for (int c = 0; c < nc_; ++c) dl[c] += w3*rr[c];
+        });
+    });
+
+    if (!direct)
+    {
+        // Exchange the partial delta of the requested tiles
+        std::vector<std::vector<double>> send(P);
+        for (int r = 0; r < P; ++r)
+        {
+            send[r].reserve(L.sendTiles[r].size()*blk);
+            for (auto id : L.sendTiles[r]) send[r].insert(send[r].end(), delta + id*blk, delta + (id + 1)*blk);
+        }
+        const std::vector<std::vector<double>> got = comm_.exchange(send);
+
+        // sum over ranks, in rank order
+        for (int r = 0; r < P; ++r)
+        {
+            if (r == me)
+            {
+                for (std::int64_t id = 0; id < nOwn; ++id)
+                {
+                    double* ph = &L.phi[L.toView(id)*blk];
+                    const double* dl = delta + id*blk;
+                    for (int j = 0; j < blk; ++j) ph[j] += dl[j];
+                }
+            }
+            else
+            {
+                for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t)
+                {
+                    double* ph = &L.phi[L.recvTiles[r][t]*blk];
+                    const double* dl = &got[r][t*blk];
+                    for (int j = 0; j < blk; ++j) ph[j] += dl[j];
+                }
+            }
+        }
+    }
+    const std::size_t nNodes = L.phi.size()/nc_;
+    for (std::size_t n = 0; n < nNodes; ++n)
+        for (int c = 0; c < nc_; ++c)
+        {
+            const double o = L.omega[n*nw_ + (nw_ == 1 ? 0 : c)];
+            L.phi[n*nc_ + c] = o > 0 ? L.phi[n*nc_ + c]/o : 0.0;
+        }
+
+    // Residuals at this rank's control points
+    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+        double acc[3] = {0, 0, 0};
+        evalStencil(L.view, L.phi.data(), nc_, st, acc);
+        for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= acc[c];
+    });
+}
+
+template <int D>
+void multilevel<D>::residualStats(double& maxr, double& rms) const
+{
+    double m = 0, s = 0, n = 0;
+    for (std::size_t i = 0; i < ctrl_.size; ++i)
+        for (int c = 0; c < nc_; ++c)
+        {
+            if (!(mask_.empty() || mask_[i*nc_ + c])) continue;
+            const double r = residual_[i*nc_ + c];
+            m = std::max(m, std::abs(r));
+            s += r*r;
+            n += 1;
+        }
+    maxr = comm_.max(m);
+    const std::vector<double> sn = comm_.sum(std::vector<double>{s, n});
+    rms = sn[1] > 0 ? std::sqrt(sn[0]/sn[1]) : 0.0;
+}
+
+template <int D>
+const fitReport& multilevel<D>::fit(const std::vector<double>& values)
+{
+    const double t0 = now();
+    double vmax = 0;
+    collectively(comm_, [&] {
+        precondition(values.size() == ctrl_.size*nc_,
+            "mba: " + std::to_string(values.size()) + " control values, expected "
+            + std::to_string(ctrl_.size*nc_) + " (control points x components)");
+        for (std::size_t i = 0; i < values.size(); ++i)
+        {
+            if (!(mask_.empty() || mask_[i])) continue;
+            precondition(std::isfinite(values[i]),
+                "mba: control value " + std::to_string(i/nc_) + " component " + std::to_string(i%nc_)
+                + " is not finite");
+            vmax = std::max(vmax, std::abs(values[i]));
+        }
+    });
+    fitReport& rep = report_;
+    rep = fitReport();
+    rep.maxValue = comm_.max(vmax);
+    rep.threshold = p_.relative ? p_.tolerance*rep.maxValue : p_.tolerance;
+
+    residual_ = values;
+    if (p_.affine)
+    {
+        affine_.solve(comm_, ctrl_, mask_, values);
+        for (std::size_t i = 0; i < ctrl_.size; ++i)
+        {
+            double g[3] = {0, 0, 0};
+            affine_.addTo(ctrl_[i], g);
+            for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= g[c];
+        }
+    }
+    double maxr, rms;
+    residualStats(maxr, rms);
+    rep.initialMaxResidual = maxr;
+    int k = 0;
+    while (!(maxr <= rep.threshold) && k < p_.maxLevels)
+    {
+        if (k == int(levels_.size())) buildLevel(k);
+        const double t1 = now();
+        applyLevel(*levels_[k]);
+        residualStats(maxr, rms);
+        levelStats& s = levels_[k]->stats;
+        s.maxResidual = maxr;
+        s.rmsResidual = rms;
+        s.seconds = now() - t1;
+        ++k;
+    }
+    rep.levels = k;
+    fold();
+    rep.maxResidual = maxr;
+    rep.rmsResidual = rms;
+    rep.converged = maxr <= rep.threshold;
+    rep.seconds = now() - t0;
+    return rep;
+}
+
+namespace {
+
+/// Offset of node j in a dense tile layout with ntile tiles per direction
+template <int D>
+std::int64_t denseOffset(const index<D>& j, const index<D>& ntile)
+{
+    std::int64_t t = 0, n = 0;
+    for (int d = 0; d < D; ++d)
+    {
+        t = t*ntile[d] + j[d]/tileEdge;
+        n = n*tileEdge + j[d]%tileEdge;
+    }
+    return t*tileSize<D>::nodes + n;
+}
+
+/// Fine-level parents of fine node jf in one direction (uniform cubic B-spline
+/// subdivision): node 2j-1 = (P[j-1] + 6 P[j] + P[j+1])/8, node 2j = (P[j] + P[j+1])/2
+inline int parents(std::int64_t jf, std::int64_t jmax, std::int64_t* j, double* w)
+{
+    int n = 0;
+    auto add = [&](std::int64_t i, double wt) { if (i >= 0 && i <= jmax) { j[n] = i; w[n] = wt; ++n; } };
+    if (jf % 2 == 0) { add(jf/2, 0.5); add(jf/2 + 1, 0.5); }
+    else { const std::int64_t c = (jf + 1)/2; add(c - 1, 0.125); add(c, 0.75); add(c + 1, 0.125); }
+    return n;
+}
+
+} // namespace
+
+template <int D>
+void multilevel<D>::fold()
+{
+    folded_ = -1;
+    int m = -1;
+    while (m + 1 < report_.levels && levels_[m + 1]->view.dense()) ++m;
+    if (m < 1) return;
+    std::vector<double> F = levels_[0]->phi, G;
+    for (int k = 1; k <= m; ++k)
+    {
+        index<D> nc, nf, tc, tf;
+        for (int d = 0; d < D; ++d)
+        {
+            nc[d] = dom_.nodes(k - 1, d);
+            nf[d] = dom_.nodes(k, d);
+            tc[d] = (nc[d] + tileEdge - 1)/tileEdge;
+            tf[d] = (nf[d] + tileEdge - 1)/tileEdge;
+        }
+        G = levels_[k]->phi;
+        index<D> jf{};
+        for (;;)
+        {
+            std::int64_t pj[D][3];
+            double pw[D][3];
+            int np[D];
+            for (int d = 0; d < D; ++d) np[d] = parents(jf[d], nc[d] - 1, pj[d], pw[d]);
+            double acc[3] = {0, 0, 0};
+            int a[D] = {};
+            for (;;)
+            {
+                index<D> jc;
+                double w = 1;
+                for (int d = 0; d < D; ++d) { jc[d] = pj[d][a[d]]; w *= pw[d][a[d]]; }
+                const double* f = &F[denseOffset<D>(jc, tc)*nc_];
+                for (int c = 0; c < nc_; ++c) acc[c] += w*f[c];
+                int d = D - 1;
+                while (d >= 0 && a[d] == np[d] - 1) { a[d] = 0; --d; }
+                if (d < 0) break;
+                ++a[d];
+            }
+            double* g = &G[denseOffset<D>(jf, tf)*nc_];
+            for (int c = 0; c < nc_; ++c) g[c] += acc[c];
+            int d = D - 1;
+            while (d >= 0 && jf[d] == nf[d] - 1) { jf[d] = 0; --d; }
+            if (d < 0) break;
+            ++jf[d];
+        }
+        F.swap(G);
+    }
+    foldedPhi_.swap(F);
+    folded_ = m;
+}
+
+template <int D>
+void multilevel<D>::addLevels(const double* x, double* out, int nLevels) const
+{
+    affine_.addTo(x, out);
+    const point<D> u0 = dom_.local0(x);
+    for (int k = std::max(folded_, 0); k < nLevels; ++k)
+    {
+        const level& L = *levels_[k];
+        const point<D> u = scaled<D>(u0, L.scale);
+        const double* phi = k == folded_ ? foldedPhi_.data() : L.phi.data();
+        // No stored tile here: none at finer levels either (their nodes lie
+        // within the stencils of the same control points)
+        if (!evalStencil(L.view, phi, nc_, stencil<D>(u.data()), out)) break;
+    }
+}
+
+template <int D>
+void multilevel<D>::evaluate(std::vector<double>& out) const
+{
+    out.assign(eval_.size*nc_, 0.0);
+    for (const std::uint32_t i : evalOrder_) addLevels(eval_[i], &out[i*nc_], report_.levels);
+}
+
+template <int D>
+void multilevel<D>::evaluate(const double* x, double* out) const
+{
+    if (comm_.size() != 1)
+        throw std::logic_error("mba: evaluation at unplanned points needs the serial communicator");
+    for (int c = 0; c < nc_; ++c) out[c] = 0;
+    addLevels(x, out, report_.levels);
+}
+
+template <int D>
+void multilevel<D>::evaluateControl(std::vector<double>& out) const
+{
+    out.assign(ctrl_.size*nc_, 0.0);
+    for (std::size_t i = 0; i < ctrl_.size; ++i) addLevels(ctrl_[i], &out[i*nc_], report_.levels);
+}
+
+template <int D>
+std::vector<levelStats> multilevel<D>::stats() const
+{
+    std::vector<levelStats> s;
+    for (const auto& L : levels_) s.push_back(L->stats);
+    return s;
+}
+
+template <int D>
+std::int64_t multilevel<D>::bytes() const
+{
+    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + foldedPhi_.capacity())*sizeof(double)
+        + active_.capacity() + mask_.capacity()
+        + (ctrlOrder_.capacity() + evalOrder_.capacity())*sizeof(std::uint32_t));
+    for (const auto& L : levels_) b += L->stats.bytes;
+    return b;
+}
+
+template <int D>
+std::int64_t multilevel<D>::gatherAllBytes() const
+{
+    std::int64_t mine = 0;
+    for (auto a : active_) mine += a;
+    return (nCtrlGlobal_ - mine)*(D + nc_)*std::int64_t(sizeof(double));
+}
+
+template class multilevel<2>;
+template class multilevel<3>;
+
+} // namespace mba

@@ -1,0 +1,158 @@
+// bsplineMorph: OpenFOAM-free multilevel B-spline core
+// Multilevel B-spline approximation of scattered vector data (Lee, Wolberg &
+// Shin 1997), distributed over the ranks of a communicator (the paper's
+// Section 4; a serialCommunicator gives the plain serial method).
+//
+// Plan once, apply many: the constructor takes the geometry (control points,
+// per-component masks, evaluation points) and fixes the domain and everything
+// that depends only on it; the lattices of the levels (tile layouts, omega,
+// buckets and the communication pattern) are built the first time a fit needs
+// them and kept. fit(values) then only moves values: scatter delta, exchange
+// partial delta of shared tiles, phi = delta/omega, update the residuals.
+//
+// One level (the paper's Eq. 5-6): a control point c with residual r_c and
+// stencil weights w (4^D nodes) proposes phi_c = w r_c / sum(w^2) to its nodes;
+// each node keeps delta = sum w^2 phi_c and omega = sum w^2 and phi = delta/omega.
+// delta and omega are sums, so partial sums from different ranks add. Each rank
+// holds its own partial sums ("own" tiles), clusters them into buckets whose
+// index boxes are all-gathered; it then receives, point to point, the partial
+// sums of just the remote buckets that meet the stencils of its own query
+// points (its control and evaluation points) and adds them in rank order, so
+// every rank that sees a node gets bitwise the same phi there.
+#ifndef MBA_MULTILEVEL_HPP
+#define MBA_MULTILEVEL_HPP
+
+#include "affine.hpp"
+#include "communicator.hpp"
+#include "lattice.hpp"
+
+#include <memory>
+
+namespace mba {
+
+/// Parameters of the approximation
+struct params
+{
+    /// Stop when the largest control-point residual is at or below this
+    double tolerance = 1e-6;
+    /// tolerance is relative to the largest |control value| (else absolute)
+    bool relative = true;
+    /// Upper bound on the number of B-spline levels (>= 1)
+    int maxLevels = 12;
+    /// Cells along the longest edge of the domain at level 0 (>= 1)
+    int initialGrid = 1;
+    /// Least-squares affine initial approximation, subtracted before the levels,
+    /// so that translations, rotations-free shears and scalings of all control
+    /// points are reproduced exactly everywhere (default on: a rigid motion of
+    /// the whole boundary then moves the whole mesh rigidly)
+    bool affine = true;
+    /// Padding of the bounding box on each side, relative to its largest extent (> 0)
+    double padding = 1e-3;
+    /// Target number of tiles per exchange bucket (>= 1)
+    int bucketTiles = 32;
+
+    /// Throws std::invalid_argument naming the offending parameter
+    void validate() const;
+};
+
+/// Statistics of one level
+struct levelStats
+{
+    int level = 0;
+    double h = 0;                         ///< cell edge
+    std::int64_t ownTiles = 0;            ///< tiles holding this rank's partial sums
+    std::int64_t viewTiles = 0;           ///< tiles of the rank's view (own + received)
+    bool dense = false;                   ///< view stored densely
+    std::int64_t nodes = 0;               ///< node slots stored in the view
+    std::int64_t bytes = 0;               ///< bytes of the level (view data, layouts)
+    std::int64_t buckets = 0;             ///< this rank's buckets
+    std::int64_t tilesSent = 0, tilesReceived = 0; ///< per apply, to / from other ranks
+    std::int64_t messagesSent = 0, messagesReceived = 0;
+    std::int64_t bytesSentPerApply = 0, bytesReceivedPerApply = 0;
+    double maxResidual = 0, rmsResidual = 0; ///< after this level (global)
+    double seconds = 0;                   ///< time of the last apply of this level
+    double planSeconds = 0;               ///< time to build the level
+};
+
+/// Result of one fit
+struct fitReport
+{
+    int levels = 0;                 ///< levels used
+    double threshold = 0;           ///< absolute residual threshold applied
+    double maxValue = 0;            ///< largest |control value| (global)
+    double initialMaxResidual = 0;  ///< after the affine part (before any level)
+    double maxResidual = 0;         ///< final (global)
+    double rmsResidual = 0;         ///< final (global)
+    double seconds = 0;
+    bool converged = false;         ///< maxResidual <= threshold
+};
+
+template <int D>
+class multilevel
+{
+    struct level;
+
+    const communicator& comm_;
+    params p_;
+    int nc_, nw_;                       ///< components; omega values per node (1 or nc)
+    pointsView<D> ctrl_, eval_;
+    std::vector<std::uint8_t> mask_;    ///< per control point x component, empty: all
+    std::vector<std::uint8_t> active_;  ///< control point constrains something
+    domain<D> dom_;
+    affineFit<D> affine_;
+    std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
+    std::vector<std::uint32_t> ctrlOrder_, evalOrder_; ///< active control / evaluation points in space-filling-curve order
+    std::vector<std::unique_ptr<level>> levels_;
+    std::vector<double> residual_, scratch_;
+    /// Levels 0..folded_ (all dense) refined into one lattice at level folded_
+    /// (B-spline subdivision: exact), so evaluation costs one stencil for them
+    int folded_ = -1;
+    std::vector<double> foldedPhi_;
+    fitReport report_;
+    std::int64_t nCtrlGlobal_ = 0;
+
+    void buildLevel(int k);
+    void applyLevel(level& L);
+    template <class F> void forOwnStencils(const level& L, F&& f) const;
+    void residualStats(double& maxr, double& rms) const;
+    void addLevels(const double* x, double* out, int nLevels) const;
+    void fold();
+
+public:
+    /// The plan. control, evaluation: this rank's points (not copied: they must
+    /// outlive the object). mask: per control point x component 0/1 (empty: all
+    /// constrained). The domain is the padded bounding box of all ranks' control
+    /// and evaluation points, unless bounds is given (it must contain them).
+    /// Collective.
+    multilevel(const communicator& comm, const params& p, int nComponents,
+               pointsView<D> control, std::vector<std::uint8_t> mask,
+               pointsView<D> evaluation, const box<D>* bounds = nullptr);
+    ~multilevel();
+
+    /// Fit the control values (point x component; unconstrained components are
+    /// ignored). Collective. Repeated fits reuse the plan.
+    const fitReport& fit(const std::vector<double>& values);
+
+    /// The approximation at the planned evaluation points (point x component)
+    void evaluate(std::vector<double>& out) const;
+
+    /// The approximation at x (serial communicator only: in parallel a rank holds
+    /// the lattices only near its own planned points); throws std::out_of_range
+    /// outside the domain
+    void evaluate(const double* x, double* out) const;
+
+    /// The approximation at this rank's control points (point x component)
+    void evaluateControl(std::vector<double>& out) const;
+
+    const domain<D>& dom() const { return dom_; }
+    const fitReport& report() const { return report_; }
+    std::vector<levelStats> stats() const;
+    /// Bytes held by the plan (levels and work arrays)
+    std::int64_t bytes() const;
+    /// Bytes each rank would receive if it gathered every control point instead
+    std::int64_t gatherAllBytes() const;
+    int nComponents() const { return nc_; }
+};
+
+} // namespace mba
+#endif
