@@ -1,0 +1,110 @@
+// bsplineMorph: one conformance suite for every mba::communicator
+// implementation (serial, simulated ranks, Pstream under mpirun).
+//
+// communicatorConformance(comm) runs on every rank of comm and uses Catch2
+// assertions (serialised, so simulated ranks in threads can share them); it
+// must be called collectively (all ranks, same order).
+#ifndef BSM_COMMUNICATOR_CONFORMANCE_HPP
+#define BSM_COMMUNICATOR_CONFORMANCE_HPP
+
+#include "communicator.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace bsmTest {
+
+/// Catch2 assertions are not thread safe: simulated ranks take turns
+inline std::mutex& assertionMutex()
+{
+    static std::mutex m;
+    return m;
+}
+
+#define BSM_CHECK(expr) do { std::lock_guard<std::mutex> bsmLock_(bsmTest::assertionMutex()); CHECK(expr); } while (0)
+#define BSM_REQUIRE(expr) do { std::lock_guard<std::mutex> bsmLock_(bsmTest::assertionMutex()); REQUIRE(expr); } while (0)
+
+inline void communicatorConformance(const mba::communicator& comm)
+{
+    const int P = comm.size(), me = comm.rank();
+    BSM_REQUIRE(P >= 1);
+    BSM_REQUIRE(me >= 0);
+    BSM_REQUIRE(me < P);
+
+    // all-gather: rank r contributes r+1 values r*10+i; empty contributions allowed
+    {
+        std::vector<std::int64_t> mine;
+        for (int i = 0; i <= me; ++i) mine.push_back(me*10 + i);
+        const auto all = comm.allGather(mine);
+        BSM_REQUIRE(int(all.size()) == P);
+        for (int r = 0; r < P; ++r)
+        {
+            BSM_REQUIRE(int(all[r].size()) == r + 1);
+            for (int i = 0; i <= r; ++i) BSM_CHECK(all[r][i] == r*10 + i);
+        }
+        const auto none = comm.allGather(std::vector<double>{});
+        BSM_REQUIRE(int(none.size()) == P);
+        for (const auto& v : none) BSM_CHECK(v.empty());
+    }
+
+    // reductions: exact values, identical on every rank (collectives are
+    // called outside the assertions: those take turns)
+    {
+        const double s = comm.sum(double(me) + 0.5);
+        const double mx = comm.max(double(me));
+        const double mn = comm.min(double(me) - 3);
+        const std::int64_t si = comm.sum(std::int64_t(me + 1));
+        BSM_CHECK(s == double(P)*(P - 1)/2 + 0.5*P);
+        BSM_CHECK(mx == double(P - 1));
+        BSM_CHECK(mn == -3.0);
+        BSM_CHECK(si == std::int64_t(P)*(P + 1)/2);
+        // a sum that depends on the order of addition: the same bits everywhere
+        const double tricky = comm.sum(me % 2 ? 1e16 : 1.0);
+        const auto seen = comm.allGather(std::vector<double>{tricky});
+        for (const auto& v : seen) BSM_CHECK(v[0] == tricky);
+        const std::vector<double> vs = comm.sum(std::vector<double>{1.0, double(me)});
+        BSM_REQUIRE(vs.size() == 2);
+        BSM_CHECK(vs[0] == double(P));
+        BSM_CHECK(vs[1] == double(P)*(P - 1)/2);
+    }
+
+    // point-to-point exchange: rank me sends (me+1)*(to+1) values to 'to' when
+    // (me + to) is even, nothing otherwise (so some pairs exchange no message)
+    {
+        std::vector<std::vector<double>> send(P);
+        for (int to = 0; to < P; ++to)
+            if ((me + to) % 2 == 0)
+                for (int i = 0; i < (me + 1)*(to + 1); ++i) send[to].push_back(1000.0*me + to + 1e-3*i);
+        const auto got = comm.exchange(send);
+        BSM_REQUIRE(int(got.size()) == P);
+        for (int from = 0; from < P; ++from)
+        {
+            if ((me + from) % 2 != 0) { BSM_CHECK(got[from].empty()); continue; }
+            BSM_REQUIRE(int(got[from].size()) == (from + 1)*(me + 1));
+            for (int i = 0; i < int(got[from].size()); ++i)
+                BSM_CHECK(got[from][i] == 1000.0*from + me + 1e-3*i);
+        }
+    }
+
+    // collective check: passes everywhere, or throws the same message on every rank
+    {
+        comm.check(true, "unused");   // must not throw
+        std::string msg;
+        try
+        {
+            comm.check(me != P - 1, "bad input on the last rank");
+        }
+        catch (const mba::collectiveError& e)
+        {
+            msg = e.what();
+        }
+        BSM_CHECK(msg.find("bad input on the last rank") != std::string::npos);
+    }
+}
+
+} // namespace bsmTest
+#endif

@@ -1,0 +1,311 @@
+// Serial multilevel B-spline approximation: invariants, sparsity, plan/apply, bad input
+#include "testData.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <limits>
+
+using namespace mba;
+using namespace bsmTest;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const serialCommunicator serial;
+
+template <int D>
+void singlePointReproduced(bool affine)
+{
+    const std::vector<point<D>> c = randomPoints<D>(1, 7);
+    const std::vector<point<D>> e = randomPoints<D>(50, 8);
+    params p;
+    p.affine = affine;
+    p.maxLevels = 1;
+    p.tolerance = 0;
+    multilevel<D> m(serial, p, 3, c, {}, e);
+    const std::vector<double> v{0.7, -1.3, 2.9};
+    m.fit(v);
+    std::vector<double> out;
+    m.evaluateControl(out);
+    for (int k = 0; k < 3; ++k) CHECK_THAT(out[k], Catch::WithinAbs(v[k], 1e-14));
+}
+
+template <int D>
+void affineReproduced()
+{
+    const std::vector<point<D>> c = randomPoints<D>(200, 11, -2, 3);
+    const std::vector<point<D>> e = randomPoints<D>(500, 12, -2, 3);
+    const double a[3] = {0.3, -1.0, 2.0};
+    const double B[3][3] = {{1.0, 0.2, -0.5}, {0.0, -0.7, 0.4}, {0.9, 0.1, 0.3}};
+    auto g = [&](const point<D>& x, int k) {
+        double s = a[k];
+        for (int d = 0; d < D; ++d) s += B[k][d]*x[d];
+        return s;
+    };
+    std::vector<double> v;
+    for (const auto& x : c) for (int k = 0; k < 3; ++k) v.push_back(g(x, k));
+    params p;
+    p.tolerance = 1e-12;
+    multilevel<D> m(serial, p, 3, c, {}, e);
+    const fitReport& r = m.fit(v);
+    CHECK(r.levels == 0);
+    std::vector<double> out;
+    m.evaluate(out);
+    for (std::size_t i = 0; i < e.size(); ++i)
+        for (int k = 0; k < 3; ++k) REQUIRE_THAT(out[i*3 + k], Catch::WithinAbs(g(e[i], k), 1e-12));
+}
+
+template <int D>
+void residualDecreases(bool affine)
+{
+    const std::vector<point<D>> c = randomPoints<D>(D == 3 ? 3000 : 1000, 21);
+    const std::vector<point<D>> e = randomPoints<D>(100, 22);
+    const std::vector<double> v = smoothValues<D>(c, 2);
+    params p;
+    p.tolerance = 1e-10;
+    p.maxLevels = 20;
+    p.affine = affine;
+    multilevel<D> m(serial, p, 2, c, {}, e);
+    const fitReport& r = m.fit(v);
+    CHECK(r.converged);
+    CHECK(r.maxResidual <= 1e-10*maxAbs(v));
+    double prev = r.initialMaxResidual;
+    const auto st = m.stats();
+    REQUIRE(int(st.size()) >= r.levels);
+    for (int k = 0; k < r.levels; ++k)
+    {
+        INFO("level " << k);
+        CHECK(st[k].maxResidual <= prev);
+        prev = st[k].maxResidual;
+    }
+    // the residual reported is the one evaluation gives at the control points
+    std::vector<double> out;
+    m.evaluateControl(out);
+    for (std::size_t i = 0; i < v.size(); ++i) REQUIRE_THAT(out[i], Catch::WithinAbs(v[i], 2e-10*maxAbs(v)));
+}
+
+} // namespace
+
+TEST_CASE("one control point is reproduced exactly (Eq. 4)", "[core]")
+{
+    singlePointReproduced<2>(false);
+    singlePointReproduced<3>(false);
+    singlePointReproduced<2>(true);
+    singlePointReproduced<3>(true);
+}
+
+TEST_CASE("affine fields are reproduced everywhere with the affine start", "[core]")
+{
+    affineReproduced<2>();
+    affineReproduced<3>();
+}
+
+TEST_CASE("the max residual never grows and reaches 1e-10 on smooth data", "[core]")
+{
+    const bool affine = GENERATE(true, false);
+    residualDecreases<2>(affine);
+    residualDecreases<3>(affine);
+}
+
+TEST_CASE("sparse storage grows with the surface, not the volume", "[core]")
+{
+    const auto c = surfacePoints<3>(40);
+    const auto e = randomPoints<3>(10, 3);
+    params p;
+    p.tolerance = 1e-14;
+    p.maxLevels = 9;
+    multilevel<3> m(serial, p, 1, c, {}, e);
+    m.fit(smoothValues<3>(c, 1));
+    const auto st = m.stats();
+    REQUIRE(st.size() >= 6);
+    for (std::size_t k = 1; k < st.size(); ++k)
+    {
+        INFO("level " << k);
+        const double nk = double(m.dom().nodes(int(k), 0));
+        const double dense = nk*nk*nk;
+        if (st[k].dense) continue;
+        // a band around the 6 faces: a few node layers thick
+        CHECK(st[k].nodes < 6*nk*nk*16);
+        if (nk > 200) CHECK(st[k].nodes < 0.25*dense);   // 8 layers of 6 faces: 6*8/nk of the volume
+        // halving the spacing: about 4x the nodes (surface), never 8x (volume)
+        if (!st[k - 1].dense) CHECK(double(st[k].nodes) < 5.0*st[k - 1].nodes);
+    }
+    CHECK_FALSE(st.back().dense);
+}
+
+TEST_CASE("applying new values through the plan equals a fresh fit", "[core]")
+{
+    const auto c = randomPoints<3>(2000, 31);
+    const auto e = randomPoints<3>(3000, 32);
+    std::vector<std::uint8_t> mask(c.size()*2, 1);
+    for (std::size_t i = 0; i < c.size(); i += 3) mask[2*i + 1] = 0;
+    params p;
+    p.tolerance = 1e-9;
+    multilevel<3> plan(serial, p, 2, c, mask, e);
+    std::vector<double> v1 = smoothValues<3>(c, 2), v2 = v1;
+    for (auto& x : v2) x = 0.3*x*x - x;
+    plan.fit(v1);
+    plan.fit(v2);
+    std::vector<double> a, b;
+    plan.evaluate(a);
+    multilevel<3> fresh(serial, p, 2, c, mask, e);
+    fresh.fit(v2);
+    fresh.evaluate(b);
+    REQUIRE(a.size() == b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) REQUIRE(a[i] == b[i]);
+    CHECK(plan.report().levels == fresh.report().levels);
+}
+
+TEST_CASE("masked components constrain only what they mask", "[core]")
+{
+    // points on the plane x=0 constrain only component 0 (a slip plane);
+    // component 1 is fixed by another point set
+    std::vector<point<3>> c;
+    std::vector<std::uint8_t> mask;
+    std::vector<double> v;
+    const auto inner = randomPoints<3>(400, 41, 0.3, 0.7);
+    for (const auto& x : inner) { c.push_back(x); mask.insert(mask.end(), {1, 1}); v.push_back(0.1); v.push_back(0.2); }
+    const auto plane = randomPoints<3>(400, 42);
+    for (auto x : plane) { x[0] = 0; c.push_back(x); mask.insert(mask.end(), {1, 0}); v.push_back(0.0); v.push_back(123.0); }
+    params p;
+    p.tolerance = 1e-12;
+    p.maxLevels = 14;
+    multilevel<3> m(serial, p, 2, c, mask, std::vector<point<3>>{});
+    const fitReport& r = m.fit(v);
+    CHECK(r.converged);
+    std::vector<double> out;
+    m.evaluateControl(out);
+    for (std::size_t i = 0; i < inner.size(); ++i)
+    {
+        REQUIRE_THAT(out[2*i], Catch::WithinAbs(0.1, 1e-12));
+        REQUIRE_THAT(out[2*i + 1], Catch::WithinAbs(0.2, 1e-12));
+    }
+    for (std::size_t i = inner.size(); i < c.size(); ++i)
+    {
+        REQUIRE_THAT(out[2*i], Catch::WithinAbs(0.0, 1e-12));
+        CHECK(std::abs(out[2*i + 1] - 123.0) > 1);   // free: not pulled to the ignored value
+    }
+}
+
+TEST_CASE("bad input gets a clear error", "[core][errors]")
+{
+    auto c = randomPoints<3>(20, 51);
+    auto e = randomPoints<3>(20, 52);
+    const params p;
+    SECTION("non-finite control coordinate")
+    {
+        c[3][1] = std::numeric_limits<double>::quiet_NaN();
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 1, c, {}, e)), Contains("control point 3") && Contains("non-finite"));
+    }
+    SECTION("non-finite evaluation coordinate")
+    {
+        e[7][0] = std::numeric_limits<double>::infinity();
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 1, c, {}, e)), Contains("evaluation point 7"));
+    }
+    SECTION("non-finite value")
+    {
+        multilevel<3> m(serial, p, 1, c, {}, e);
+        std::vector<double> v(20, 1.0);
+        v[5] = std::numeric_limits<double>::quiet_NaN();
+        REQUIRE_THROWS_WITH(m.fit(v), Contains("control value 5") && Contains("not finite"));
+    }
+    SECTION("mismatched sizes")
+    {
+        multilevel<3> m(serial, p, 2, c, {}, e);
+        REQUIRE_THROWS_WITH(m.fit(std::vector<double>(20, 1.0)), Contains("20 control values, expected 40"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 2, c, std::vector<std::uint8_t>(3, 1), e)), Contains("mask"));
+    }
+    SECTION("zero or negative parameters")
+    {
+        params q;
+        q.maxLevels = 0;
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("maxLevels"));
+        q = params();
+        q.tolerance = -1;
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("tolerance"));
+        q = params();
+        q.initialGrid = 0;
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("initialGrid"));
+        q = params();
+        q.padding = 0;
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("padding"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 0, c, {}, e)), Contains("components"));
+    }
+    SECTION("evaluation outside the domain")
+    {
+        multilevel<3> m(serial, p, 1, c, {}, e);
+        m.fit(std::vector<double>(20, 1.0));
+        const double x[3] = {5, 0.5, 0.5};
+        double out[1];
+        REQUIRE_THROWS_AS(m.evaluate(x, out), std::out_of_range);
+    }
+}
+
+TEST_CASE("degenerate input has documented results", "[core][errors]")
+{
+    const auto e = randomPoints<3>(100, 61);
+    params p;
+    p.maxLevels = 8;
+    SECTION("no control points: zero everywhere")
+    {
+        multilevel<3> m(serial, p, 3, std::vector<point<3>>{}, {}, e);
+        const fitReport& r = m.fit({});
+        CHECK(r.levels == 0);
+        std::vector<double> out;
+        m.evaluate(out);
+        REQUIRE(out.size() == 300);
+        for (double x : out) REQUIRE(x == 0.0);
+    }
+    SECTION("all control points on one plane")
+    {
+        p.maxLevels = 14;
+        auto c = randomPoints<3>(300, 62);
+        for (auto& x : c) x[2] = 0.5;
+        const auto v = smoothValues<3>(c, 1);
+        multilevel<3> m(serial, p, 1, c, {}, c);   // evaluated on the plane itself
+        const fitReport& r = m.fit(v);
+        CHECK(std::isfinite(r.maxResidual));
+        std::vector<double> out;
+        m.evaluate(out);
+        for (std::size_t i = 0; i < out.size(); ++i) REQUIRE_THAT(out[i], Catch::WithinAbs(v[i], 1e-6*maxAbs(v)));
+    }
+    SECTION("collinear control points, affine start")
+    {
+        std::vector<point<3>> c;
+        std::vector<double> v;
+        for (int i = 0; i < 50; ++i) { c.push_back({{i/49.0, 0.2, 0.3}}); v.push_back(1 + 2*(i/49.0)); }
+        multilevel<3> m(serial, p, 1, c, {}, c);
+        const fitReport& r = m.fit(v);
+        CHECK(r.levels == 0);    // a linear field along the line is affine
+        std::vector<double> out;
+        m.evaluate(out);
+        for (std::size_t i = 0; i < out.size(); ++i) REQUIRE_THAT(out[i], Catch::WithinAbs(v[i], 1e-12));
+    }
+    SECTION("duplicate points with conflicting values: least squares, stops at maxLevels")
+    {
+        std::vector<point<3>> c = randomPoints<3>(30, 63);
+        std::vector<double> v(30, 0.0);
+        c.push_back(c[0]);
+        v[0] = 1.0;
+        v.push_back(3.0);
+        multilevel<3> m(serial, p, 1, c, {}, e);
+        const fitReport& r = m.fit(v);
+        CHECK(r.levels == p.maxLevels);
+        CHECK_FALSE(r.converged);
+        std::vector<double> out;
+        m.evaluateControl(out);
+        CHECK_THAT(out[0], Catch::WithinAbs(2.0, 1e-9));   // the mean of the two
+        CHECK(out[0] == out[30]);
+        m.evaluate(out);
+        for (double x : out) REQUIRE(std::isfinite(x));
+    }
+    SECTION("a single control point")
+    {
+        const std::vector<point<3>> c{{{0.5, 0.5, 0.5}}};
+        multilevel<3> m(serial, p, 1, c, {}, std::vector<point<3>>{});
+        m.fit({4.0});
+        double out[1];
+        m.evaluate(c[0].data(), out);
+        CHECK_THAT(out[0], Catch::WithinAbs(4.0, 1e-14));
+    }
+}

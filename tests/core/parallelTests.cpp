@@ -1,0 +1,230 @@
+// The distributed algorithm on simulated ranks: equal to serial, bitwise
+// consistent, communication bounded, failures collective; and the
+// communicator conformance suite for the serial and simulated implementations.
+#include "communicatorConformance.hpp"
+#include "testData.hpp"
+
+#include <catch2/catch.hpp>
+
+
+using namespace mba;
+using namespace bsmTest;
+using Catch::Matchers::Contains;
+
+namespace {
+
+enum class partition { slabs, random };
+
+/// Rank of point i: slabs along x, or seeded random
+template <int D>
+std::vector<int> ranksOf(const std::vector<point<D>>& x, int P, partition how, unsigned seed)
+{
+    std::vector<int> r(x.size());
+    std::mt19937 rng(seed);
+    for (std::size_t i = 0; i < x.size(); ++i)
+        r[i] = how == partition::slabs ? std::min(P - 1, int(x[i][0]*P)) : int(rng() % unsigned(P));
+    return r;
+}
+
+struct problem
+{
+    int nc = 3;
+    params p;
+    bool masked = false;
+};
+
+/// Values at every evaluation point (global order) from P ranks
+template <int D>
+std::vector<double> solve(int P, partition how, const std::vector<point<D>>& c, const std::vector<double>& v,
+                          const std::vector<std::uint8_t>& mask, const std::vector<point<D>>& e, const problem& pb)
+{
+    const auto rc = ranksOf<D>(c, P, how, 1), re = ranksOf<D>(e, P, how, 2);
+    std::vector<double> out(e.size()*pb.nc, std::numeric_limits<double>::quiet_NaN());
+    runSimulated(P, [&](const communicator& comm) {
+        std::vector<point<D>> cl, el;
+        std::vector<double> vl;
+        std::vector<std::uint8_t> ml;
+        std::vector<std::size_t> eg;
+        for (std::size_t i = 0; i < c.size(); ++i)
+        {
+            if (rc[i] != comm.rank()) continue;
+            cl.push_back(c[i]);
+            for (int k = 0; k < pb.nc; ++k)
+            {
+                vl.push_back(v[i*pb.nc + k]);
+                if (!mask.empty()) ml.push_back(mask[i*pb.nc + k]);
+            }
+        }
+        for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) { el.push_back(e[i]); eg.push_back(i); }
+        multilevel<D> m(comm, pb.p, pb.nc, cl, ml, el);
+        m.fit(vl);
+        m.fit(vl);   // a second apply through the plan
+        std::vector<double> o;
+        m.evaluate(o);
+        for (std::size_t j = 0; j < eg.size(); ++j)
+            for (int k = 0; k < pb.nc; ++k) out[eg[j]*pb.nc + k] = o[j*pb.nc + k];   // disjoint writes
+    });
+    return out;
+}
+
+template <int D>
+void serialEqualsRanks(bool affine, bool masked, partition how)
+{
+    const auto c = randomPoints<D>(D == 3 ? 1500 : 600, 71);
+    const auto e = randomPoints<D>(2000, 72);
+    problem pb;
+    pb.p.affine = affine;
+    pb.p.tolerance = 1e-9;
+    pb.p.bucketTiles = 8;
+    const std::vector<double> v = smoothValues<D>(c, pb.nc);
+    std::vector<std::uint8_t> mask;
+    if (masked)
+    {
+        mask.assign(c.size()*pb.nc, 1);
+        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*pb.nc + i % 3] = 0;
+    }
+    const std::vector<double> ref = solve<D>(1, how, c, v, mask, e, pb);
+    const double tol = 1e-12*maxAbs(v);
+    for (int P : {2, 3, 5, 8})
+    {
+        INFO("D " << D << ", ranks " << P << ", affine " << affine << ", masked " << masked
+             << ", partition " << (how == partition::slabs ? "slabs" : "random"));
+        const std::vector<double> got = solve<D>(P, how, c, v, mask, e, pb);
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+        CHECK(diff <= tol);
+    }
+}
+
+} // namespace
+
+TEST_CASE("communicator conformance: serial", "[parallel][conformance]")
+{
+    communicatorConformance(serialCommunicator());
+}
+
+TEST_CASE("communicator conformance: simulated ranks", "[parallel][conformance]")
+{
+    const int P = GENERATE(1, 2, 3, 5);
+    runSimulated(P, [](const communicator& comm) { communicatorConformance(comm); });
+}
+
+TEST_CASE("serial equals simulated ranks", "[parallel]")
+{
+    const bool affine = GENERATE(true, false);
+    const bool masked = GENERATE(false, true);
+    const partition how = GENERATE(partition::slabs, partition::random);
+    serialEqualsRanks<2>(affine, masked, how);
+    serialEqualsRanks<3>(affine, masked, how);
+}
+
+TEST_CASE("ranks without control or evaluation points", "[parallel]")
+{
+    // all control points on rank 0, all evaluation points on the last rank
+    const auto c = randomPoints<3>(800, 81);
+    const auto e = randomPoints<3>(500, 82);
+    const auto v = smoothValues<3>(c, 1);
+    params p;
+    p.tolerance = 1e-10;
+    std::vector<double> ref;
+    {
+        multilevel<3> m(serialCommunicator(), p, 1, c, {}, e);
+        m.fit(v);
+        m.evaluate(ref);
+    }
+    const int P = 3;
+    std::vector<double> got;
+    runSimulated(P, [&](const communicator& comm) {
+        const bool first = comm.rank() == 0, last = comm.rank() == P - 1;
+        const std::vector<point<3>> cl = first ? c : std::vector<point<3>>{};
+        const std::vector<point<3>> el = last ? e : std::vector<point<3>>{};
+        multilevel<3> m(comm, p, 1, cl, {}, el);
+        m.fit(first ? v : std::vector<double>{});
+        std::vector<double> o;
+        m.evaluate(o);
+        if (last) got = o;
+    });
+    REQUIRE(got.size() == ref.size());
+    for (std::size_t i = 0; i < ref.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(ref[i], 1e-12*maxAbs(v)));
+}
+
+TEST_CASE("a point evaluated on several ranks gets bitwise the same value", "[parallel]")
+{
+    const auto c = randomPoints<3>(1200, 91);
+    const auto shared = randomPoints<3>(300, 92);
+    const auto v = smoothValues<3>(c, 3);
+    params p;
+    p.tolerance = 1e-9;
+    const int P = 4;
+    std::vector<std::vector<double>> got(P);
+    runSimulated(P, [&](const communicator& comm) {
+        std::vector<point<3>> cl;
+        std::vector<double> vl;
+        for (std::size_t i = 0; i < c.size(); ++i)
+            if (int(i % P) == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
+        multilevel<3> m(comm, p, 3, cl, {}, shared);   // every rank evaluates the same points
+        m.fit(vl);
+        m.evaluate(got[comm.rank()]);
+    });
+    for (int r = 1; r < P; ++r)
+    {
+        REQUIRE(got[r].size() == got[0].size());
+        for (std::size_t i = 0; i < got[0].size(); ++i) REQUIRE(got[r][i] == got[0][i]);
+    }
+}
+
+TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs)", "[parallel]")
+{
+    const auto c = surfacePoints<3>(60);
+    const auto e = randomPoints<3>(20000, 101);
+    std::vector<double> v(c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) v[i] = smooth<3>(c[i], 0) + std::exp(-40*c[i][1]);
+    params p;
+    p.tolerance = 1e-8;
+    p.maxLevels = 9;
+    std::int64_t serialNodes = 0;
+    int levels = 0;
+    {
+        multilevel<3> m(serialCommunicator(), p, 1, c, {}, e);
+        levels = m.fit(v).levels;
+        serialNodes = m.stats()[levels - 1].nodes;
+    }
+    REQUIRE(levels >= 7);
+    const int P = 8;
+    std::vector<std::int64_t> recv(P), gatherAll(P);
+    runSimulated(P, [&](const communicator& comm) {
+        std::vector<point<3>> cl, el;
+        std::vector<double> vl;
+        for (std::size_t i = 0; i < c.size(); ++i)
+            if (std::min(P - 1, int(c[i][0]*P)) == comm.rank()) { cl.push_back(c[i]); vl.push_back(v[i]); }
+        for (const auto& x : e) if (std::min(P - 1, int(x[0]*P)) == comm.rank()) el.push_back(x);
+        multilevel<3> m(comm, p, 1, cl, {}, el);
+        const fitReport& r = m.fit(vl);
+        REQUIRE(r.levels == levels);
+        const levelStats finest = m.stats()[levels - 1];
+        recv[comm.rank()] = finest.tilesReceived*tileLayout<3>::nodesPerTile;
+        gatherAll[comm.rank()] = m.gatherAllBytes();
+    });
+    for (int r = 0; r < P; ++r)
+    {
+        INFO("rank " << r << " receives " << recv[r] << " of " << serialNodes << " finest-level nodes");
+        CHECK(recv[r] < serialNodes/4);
+        CHECK(gatherAll[r] > 0);
+    }
+}
+
+TEST_CASE("bad input on one rank fails every rank with the same message", "[parallel][errors]")
+{
+    const int P = 3;
+    std::vector<std::string> msg(P);
+    REQUIRE_THROWS_WITH(runSimulated(P, [&](const communicator& comm) {
+        auto c = randomPoints<3>(50, 111 + comm.rank());
+        multilevel<3> m(comm, params(), 1, c, {}, c);
+        std::vector<double> v(50, 1.0);
+        if (comm.rank() == 1) v[7] = std::numeric_limits<double>::infinity();
+        try { m.fit(v); }
+        catch (const collectiveError& e) { msg[comm.rank()] = e.what(); throw; }
+    }), Contains("control value 7") && Contains("rank 1"));
+    for (int r = 0; r < P; ++r) CHECK(msg[r] == msg[0]);
+    CHECK_FALSE(msg[0].empty());
+}
