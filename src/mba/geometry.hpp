@@ -42,6 +42,13 @@ template <int D> struct indexBox
 {
     index<D> lo, hi;
 
+    bool contains(const index<D>& i) const
+    {
+        for (int d = 0; d < D; ++d)
+            if (i[d] < lo[d] || hi[d] < i[d]) return false;
+        return true;
+    }
+
     bool intersects(const indexBox& b) const
     {
         for (int d = 0; d < D; ++d)

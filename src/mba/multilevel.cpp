@@ -189,8 +189,10 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
         for (const auto& g : groups)
         {
             box<D> qb = box<D>::empty();
-            for (auto i : g) qb.add(q[i]);
+            std::vector<const double*> members;
+            for (auto i : g) { qb.add(q[i]); members.push_back(q[i]); }
             queryBoxes_.push_back(qb);
+            queryGroups_.push_back(std::move(members));
         }
     }
     residual_.assign(ctrl_.size*nc_, 0.0);
@@ -288,7 +290,10 @@ void multilevel<D>::buildLevel(int k)
             }
             qt.push_back(t);
         }
-        std::vector<std::vector<std::int64_t>> requests(P);
+        // Remote bucket boxes that meet a cluster's stencils: ask their owner
+        // for exactly the tiles the cluster's point stencils touch
+        std::vector<indexBox<D>> remote;
+        std::vector<int> remoteRank;
         for (int r = 0; r < P; ++r)
         {
             if (r == me || qt.empty()) continue;
@@ -297,9 +302,38 @@ void multilevel<D>::buildLevel(int k)
             {
                 indexBox<D> rb;
                 for (int d = 0; d < D; ++d) { rb.lo[d] = v[2*D*b + d]; rb.hi[d] = v[2*D*b + D + d]; }
-                if (!rb.intersects(all)) continue;
-                for (const auto& t : qt)
-                    if (rb.intersects(t)) { requests[r].push_back(std::int64_t(b)); break; }
+                if (rb.intersects(all)) { remote.push_back(rb); remoteRank.push_back(r); }
+            }
+        }
+        std::vector<std::vector<std::uint64_t>> requests(P);
+        std::vector<hashMap> requested(P);
+        std::vector<std::size_t> hits;
+        for (std::size_t g = 0; g < qt.size() && !remote.empty(); ++g)
+        {
+            hits.clear();
+            for (std::size_t b = 0; b < remote.size(); ++b) if (remote[b].intersects(qt[g])) hits.push_back(b);
+            if (hits.empty()) continue;
+            for (const double* x : queryGroups_[g])
+            {
+                const point<D> u = scaled<D>(dom_.local0(x), L.scale);
+                const indexBox<D> tb = stencil<D>(u.data()).tiles();
+                index<D> t = tb.lo;
+                for (;;)
+                {
+                    for (const std::size_t b : hits)
+                    {
+                        if (!remote[b].contains(t)) continue;
+                        const int r = remoteRank[b];
+                        const std::uint64_t key = L.own.key(t);
+                        const std::size_t before = requested[r].size();
+                        requested[r].insert(key, 0);
+                        if (requested[r].size() != before) requests[r].push_back(key);
+                    }
+                    int d = D - 1;
+                    while (d >= 0 && t[d] == tb.hi[d]) { t[d] = tb.lo[d]; --d; }
+                    if (d < 0) break;
+                    ++t[d];
+                }
             }
         }
         const auto wanted = comm_.exchange(requests);
@@ -307,14 +341,13 @@ void multilevel<D>::buildLevel(int k)
         std::vector<std::vector<double>> om(P);
         for (int r = 0; r < P; ++r)
         {
-            for (auto b : wanted[r])
+            for (const std::uint64_t key : wanted[r])
             {
-                for (auto id : buckets.at(std::size_t(b)))
-                {
-                    L.sendTiles[r].push_back(id);
-                    keys[r].push_back(L.own.keyOf(id));
-                    om[r].insert(om[r].end(), ownW.begin() + id*npt*nw_, ownW.begin() + (id + 1)*npt*nw_);
-                }
+                const std::int64_t id = L.own.findKey(key);
+                if (id < 0) continue;
+                L.sendTiles[r].push_back(id);
+                keys[r].push_back(key);
+                om[r].insert(om[r].end(), ownW.begin() + id*npt*nw_, ownW.begin() + (id + 1)*npt*nw_);
             }
         }
         keysGot = comm_.exchange(keys);

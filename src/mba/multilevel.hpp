@@ -15,10 +15,11 @@
 // each node keeps delta = sum w^2 phi_c and omega = sum w^2 and phi = delta/omega.
 // delta and omega are sums, so partial sums from different ranks add. Each rank
 // holds its own partial sums ("own" tiles), clusters them into buckets whose
-// index boxes are all-gathered; it then receives, point to point, the partial
-// sums of just the remote buckets that meet the stencils of its own query
-// points (its control and evaluation points) and adds them in rank order, so
-// every rank that sees a node gets bitwise the same phi there.
+// index boxes are all-gathered (a small directory of who holds what). Each rank
+// then asks the owners of the buckets that meet the stencils of its own query
+// points (its control and evaluation points) for exactly the tiles those
+// stencils touch, receives their partial sums point to point and adds them in
+// rank order, so every rank that sees a node gets bitwise the same phi there.
 #ifndef MBA_MULTILEVEL_HPP
 #define MBA_MULTILEVEL_HPP
 
@@ -101,6 +102,7 @@ class multilevel
     domain<D> dom_;
     affineFit<D> affine_;
     std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
+    std::vector<std::vector<const double*>> queryGroups_; ///< the points of each cluster
     std::vector<std::uint32_t> ctrlOrder_, evalOrder_; ///< active control / evaluation points in space-filling-curve order
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
