@@ -1,7 +1,15 @@
 #ifndef MBA_BASIS_HPP
 #define MBA_BASIS_HPP
 namespace mba {
-/// Uniform cubic B-spline basis B0..B3 at s in [0,1) (Lee, Wolberg & Shin 1997, Eq. 2)
-void cubicBasis(double s, double w[4]);
+/// Uniform cubic B-spline basis B0..B3 at s in [0,1) (Lee, Wolberg & Shin 1997, Eq. 2):
+/// non-negative, summing to one
+inline void cubicBasis(double s, double w[4])
+{
+    const double t = 1.0 - s, s2 = s*s, s3 = s2*s;
+    w[0] = t*t*t/6.0;
+    w[1] = (3.0*s3 - 6.0*s2 + 4.0)/6.0;
+    w[2] = (-3.0*s3 + 3.0*s2 + 3.0*s + 1.0)/6.0;
+    w[3] = s3/6.0;
+}
 }
 #endif

@@ -21,6 +21,7 @@ constexpr int tileEdge = 4;
 
 template <int D> struct tileSize;
 template <> struct tileSize<2> { static constexpr int nodes = tileEdge*tileEdge; };
+static_assert(tileEdge == 2 || tileEdge == 4, "a stencil spans at most 3 tiles per direction");
 template <> struct tileSize<3> { static constexpr int nodes = tileEdge*tileEdge*tileEdge; };
 
 template <int D>
@@ -163,10 +164,10 @@ struct split1
         }
         nt = ta[3] + 1;
         r[0] = 0;
-        r[1] = nt == 1 ? 4 : int(tileEdge - (base - t0*tileEdge));
-        r[2] = 4;
+        for (int a = 1; a < 4; ++a) if (ta[a] != ta[a - 1]) r[ta[a]] = a;
+        r[nt] = 4;
     }
-    int r[3];   ///< stencil positions [r[i], r[i+1]) lie in tile t0 + i
+    int r[4];   ///< stencil positions [r[i], r[i+1]) lie in tile t0 + i
 };
 
 template <int NC>
@@ -272,7 +273,7 @@ template <class F>
 bool forStencil(const tileLayout<3>& L, const stencil<3>& st, F&& f)
 {
     const detail::split1 x(st.base[0]), y(st.base[1]), z(st.base[2]);
-    std::int64_t tid[2][2][2];
+    std::int64_t tid[3][3][3];
     bool any = false;
     for (int i = 0; i < x.nt; ++i)
         for (int j = 0; j < y.nt; ++j)
@@ -305,7 +306,7 @@ template <class F>
 bool forStencil(const tileLayout<2>& L, const stencil<2>& st, F&& f)
 {
     const detail::split1 x(st.base[0]), y(st.base[1]);
-    std::int64_t tid[2][2];
+    std::int64_t tid[3][3];
     bool any = false;
     for (int i = 0; i < x.nt; ++i)
         for (int j = 0; j < y.nt; ++j)

@@ -113,12 +113,12 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
             + std::to_string(ctrl_.size*nc_) + " (control points x components)");
         for (std::size_t i = 0; i < ctrl_.size; ++i)
             for (int d = 0; d < D; ++d)
-                precondition(std::isfinite(ctrl_[i][d]),
-                    "mba: control point " + std::to_string(i) + " has a non-finite coordinate");
+                if (!std::isfinite(ctrl_[i][d]))
+                    precondition(false, "mba: control point " + std::to_string(i) + " has a non-finite coordinate");
         for (std::size_t i = 0; i < eval_.size; ++i)
             for (int d = 0; d < D; ++d)
-                precondition(std::isfinite(eval_[i][d]),
-                    "mba: evaluation point " + std::to_string(i) + " has a non-finite coordinate");
+                if (!std::isfinite(eval_[i][d]))
+                    precondition(false, "mba: evaluation point " + std::to_string(i) + " has a non-finite coordinate");
     });
 
     // Which points constrain anything; whether masks differ between components
@@ -531,9 +531,9 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         for (std::size_t i = 0; i < values.size(); ++i)
         {
             if (!(mask_.empty() || mask_[i])) continue;
-            precondition(std::isfinite(values[i]),
-                "mba: control value " + std::to_string(i/nc_) + " component " + std::to_string(i%nc_)
-                + " is not finite");
+            if (!std::isfinite(values[i]))
+                precondition(false, "mba: control value " + std::to_string(i/nc_) + " component "
+                    + std::to_string(i%nc_) + " is not finite");
             vmax = std::max(vmax, std::abs(values[i]));
         }
     });
