@@ -1,0 +1,118 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "PstreamCommunicator.H"
+#include "Pstream.H"
+#include "PstreamBuffers.H"
+#include "UIPstream.H"
+#include "UOPstream.H"
+
+// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
+
+namespace
+{
+    Foam::List<char> toList(const mba::bytes& b)
+    {
+        Foam::List<char> l(b.size());
+        std::copy(b.begin(), b.end(), l.begin());
+        return l;
+    }
+
+    mba::bytes fromList(const Foam::UList<char>& l)
+    {
+        return mba::bytes(l.begin(), l.end());
+    }
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+int Foam::PstreamCommunicator::rank() const
+{
+    return Pstream::parRun() ? Pstream::myProcNo() : 0;
+}
+
+
+int Foam::PstreamCommunicator::size() const
+{
+    return Pstream::parRun() ? Pstream::nProcs() : 1;
+}
+
+
+std::vector<mba::bytes> Foam::PstreamCommunicator::allGatherBytes
+(
+    const mba::bytes& mine
+) const
+{
+    if (!Pstream::parRun())
+    {
+        return {mine};
+    }
+    List<List<char>> all(Pstream::nProcs());
+    all[Pstream::myProcNo()] = toList(mine);
+    Pstream::gatherList(all);
+    Pstream::scatterList(all);
+
+    std::vector<mba::bytes> out(all.size());
+    forAll(all, proci)
+    {
+        out[proci] = fromList(all[proci]);
+    }
+    return out;
+}
+
+
+std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
+(
+    const std::vector<mba::bytes>& send
+) const
+{
+    const label nProcs = size();
+    std::vector<mba::bytes> got(nProcs);
+    const label me = rank();
+    got[me] = send[me];
+    if (!Pstream::parRun())
+    {
+        return got;
+    }
+
+    PstreamBuffers pBufs(Pstream::commsTypes::nonBlocking);
+    for (label proci = 0; proci < nProcs; ++proci)
+    {
+        if (proci != me && !send[proci].empty())
+        {
+            UOPstream os(proci, pBufs);
+            os << toList(send[proci]);
+        }
+    }
+    labelList recvSizes;
+    pBufs.finishedSends(recvSizes);
+
+    for (label proci = 0; proci < nProcs; ++proci)
+    {
+        if (proci != me && recvSizes[proci] > 0)
+        {
+            UIPstream is(proci, pBufs);
+            List<char> l(is);
+            got[proci] = fromList(l);
+        }
+    }
+    return got;
+}
+
+
+// ************************************************************************* //

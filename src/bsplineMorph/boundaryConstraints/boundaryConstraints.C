@@ -1,0 +1,270 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "boundaryConstraints.H"
+#include "syncTools.H"
+#include "polyMesh.H"
+#include "OStringStream.H"
+#include "IStringStream.H"
+#include "HashOps.H"
+
+#include <cmath>
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+bool Foam::boundaryConstraints::axisMask(const pointConstraint& pc, bool mask[3])
+{
+    const scalar tol = 1e-9;
+    mask[0] = mask[1] = mask[2] = false;
+    if (pc.first() == 3)
+    {
+        mask[0] = mask[1] = mask[2] = true;
+        return true;
+    }
+    // plane: the normal; line: the free direction
+    const vector& v = pc.second();
+    for (direction d = 0; d < 3; ++d)
+    {
+        if (mag(v[d]) >= 1 - tol)
+        {
+            if (pc.first() == 1)
+            {
+                mask[d] = true;
+            }
+            else
+            {
+                mask[(d + 1) % 3] = mask[(d + 2) % 3] = true;
+            }
+            return true;
+        }
+    }
+    return false;
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::boundaryConstraints::boundaryConstraints
+(
+    const pointVectorField& pointDisplacement
+)
+:
+    pMesh_(pointDisplacement.mesh())
+{
+    const polyMesh& mesh = pMesh_();
+    const Vector<label>& solD = mesh.solutionD();
+    for (direction d = 0; d < 3; ++d)
+    {
+        if (solD[d] == 1)
+        {
+            directions_.append(d);
+        }
+    }
+
+    // Ownership: the lowest rank holding a point
+    labelList owner(mesh.nPoints(), Pstream::myProcNo());
+    syncTools::syncPointList(mesh, owner, minEqOp<label>(), labelMax);
+    owned_.setSize(mesh.nPoints());
+    forAll(owner, pointi)
+    {
+        owned_[pointi] = owner[pointi] == Pstream::myProcNo();
+    }
+
+    update(pointDisplacement);
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement)
+{
+    const polyMesh& mesh = pMesh_();
+    const label nPoints = mesh.nPoints();
+    const vectorField& disp = pointDisplacement.primitiveField();
+
+    labelList fixed(nPoints, 0);
+    value_ = vectorField(nPoints, Zero);
+    wordHashSet badPatches;
+    slide_ = List<pointConstraint>(nPoints, pointConstraint());
+
+    forAll(pointDisplacement.boundaryField(), patchi)
+    {
+        const pointPatchVectorField& pf = pointDisplacement.boundaryField()[patchi];
+        const pointPatch& pp = pf.patch();
+        const labelList& meshPoints = pp.meshPoints();
+
+        if (pp.coupled() || pf.type() == "empty")
+        {
+            continue;
+        }
+        if (pf.fixesValue())
+        {
+            for (const label pointi : meshPoints)
+            {
+                fixed[pointi] = 1;
+                value_[pointi] = disp[pointi];
+                for (direction c = 0; c < 3; ++c)
+                {
+                    if (!std::isfinite(disp[pointi][c])) badPatches.insert(pp.name());
+                }
+            }
+        }
+        else if (pf.type() == "slip")
+        {
+            const vectorField& n = pp.pointNormals();
+            forAll(meshPoints, i)
+            {
+                slide_[meshPoints[i]].applyConstraint(n[i]);
+            }
+        }
+        else if (pf.type() == "fixedNormalSlip")
+        {
+            // The normal is private to the condition: read it back from its output
+            OStringStream os;
+            pf.write(os);
+            const dictionary d(IStringStream(os.str())());
+            vector n = d.get<vector>("n");
+            n /= mag(n) + VSMALL;
+            for (const label pointi : meshPoints)
+            {
+                slide_[pointi].applyConstraint(n);
+            }
+        }
+        else if (pp.constraintType() != word::null)
+        {
+            // symmetryPlane, symmetry, wedge, cyclicSlip: the patch's own constraint
+            forAll(meshPoints, i)
+            {
+                pointConstraint pc;
+                pp.applyConstraint(i, pc);
+                slide_[meshPoints[i]].combine(pc);
+            }
+        }
+    }
+
+    // Non-finite values stop everything here, on every rank, before they
+    // reach any arithmetic (with FOAM_SIGFPE a NaN comparison traps)
+    Pstream::combineGather(badPatches, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(badPatches);
+    if (badPatches.size())
+    {
+        FatalErrorInFunction
+            << "pointDisplacement has non-finite (NaN or Inf) values on patches "
+            << flatOutput(badPatches.sortedToc()) << " at time "
+            << mesh.time().timeName() << "; the mesh is not moved"
+            << exit(FatalError);
+    }
+
+    // The same view of every processor-shared point on all its ranks
+    syncTools::syncPointList(mesh, fixed, maxEqOp<label>(), label(0));
+    syncTools::syncPointList(mesh, value_, maxMagSqrEqOp<vector>(), vector::zero);
+    syncTools::syncPointList(mesh, slide_, combineConstraintsEqOp(), pointConstraint());
+
+    fixed_.setSize(nPoints);
+    forAll(fixed, pointi)
+    {
+        fixed_[pointi] = fixed[pointi] != 0;
+    }
+
+    // Control points in the solution directions
+    const label nd = directions_.size();
+    DynamicList<label> ctrl, proj;
+    mask_.clear();
+    values_.clear();
+    forAll(fixed_, pointi)
+    {
+        bool m[3] = {false, false, false};
+        if (fixed_[pointi])
+        {
+            m[0] = m[1] = m[2] = true;
+        }
+        else if (slide_[pointi].first() > 0)
+        {
+            if (!axisMask(slide_[pointi], m))
+            {
+                proj.append(pointi);
+                continue;
+            }
+        }
+        bool any = false;
+        for (const label d : directions_)
+        {
+            any = any || m[d];
+        }
+        if (!any || !owned_[pointi])
+        {
+            continue;
+        }
+        ctrl.append(pointi);
+        for (label k = 0; k < nd; ++k)
+        {
+            const direction d = directions_[k];
+            mask_.push_back(m[d]);
+            values_.push_back(fixed_[pointi] ? value_[pointi][d] : 0.0);
+        }
+    }
+    controlPoints_.transfer(ctrl);
+    projected_.transfer(proj);
+}
+
+
+Foam::label Foam::boundaryConstraints::nControlGlobal() const
+{
+    return returnReduce(controlPoints_.size(), sumOp<label>());
+}
+
+
+void Foam::boundaryConstraints::constrain(vectorField& displacement) const
+{
+    const Vector<label>& solD = pMesh_().solutionD();
+    forAll(displacement, pointi)
+    {
+        vector& d = displacement[pointi];
+        if (fixed_[pointi])
+        {
+            d = value_[pointi];
+        }
+        else if (slide_[pointi].first() > 0)
+        {
+            bool m[3];
+            if (axisMask(slide_[pointi], m))
+            {
+                for (direction c = 0; c < 3; ++c)
+                {
+                    if (m[c]) d[c] = 0;
+                }
+            }
+            else
+            {
+                d = slide_[pointi].constrainDisplacement(d);
+            }
+        }
+        for (direction c = 0; c < 3; ++c)
+        {
+            if (solD[c] != 1) d[c] = 0;
+        }
+    }
+}
+
+
+bool Foam::boundaryConstraints::sameControls(const boundaryConstraints& other) const
+{
+    return controlPoints_ == other.controlPoints_ && mask_ == other.mask_;
+}
+
+
+// ************************************************************************* //

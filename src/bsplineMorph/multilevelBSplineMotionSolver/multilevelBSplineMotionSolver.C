@@ -1,0 +1,341 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "multilevelBSplineMotionSolver.H"
+#include "boundaryConstraints.H"
+#include "addToRunTimeSelectionTable.H"
+#include "Enum.H"
+#include "mapPolyMesh.H"
+#include "clockTime.H"
+
+// * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
+
+namespace Foam
+{
+    defineTypeNameAndDebug(multilevelBSplineMotionSolver, 0);
+
+    addToRunTimeSelectionTable
+    (
+        motionSolver,
+        multilevelBSplineMotionSolver,
+        dictionary
+    );
+
+    addToRunTimeSelectionTable
+    (
+        displacementMotionSolver,
+        multilevelBSplineMotionSolver,
+        displacement
+    );
+
+    namespace
+    {
+        enum class initialApproximation { affine, none };
+        const Enum<initialApproximation> initialApproximationNames
+        ({
+            { initialApproximation::affine, "affine" },
+            { initialApproximation::none, "none" },
+        });
+
+        enum class onInverted { fatal, warn };
+        const Enum<onInverted> onInvertedNames
+        ({
+            { onInverted::fatal, "fatal" },
+            { onInverted::warn, "warn" },
+        });
+    }
+}
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+void Foam::multilevelBSplineMotionSolver::readCoeffs()
+{
+    const dictionary& dict = coeffDict();
+
+    params_.tolerance =
+        dict.getCheckOrDefault<scalar>("tolerance", 1e-6, scalarMinMax::ge(0));
+    params_.relative = dict.lookupOrDefault<bool>("relativeTolerance", true);
+    params_.maxLevels =
+        dict.getCheckOrDefault<label>("maxLevels", 12, labelMinMax(1, 30));
+    params_.initialGrid =
+        dict.getCheckOrDefault<label>("initialGrid", 1, labelMinMax(1, 1 << 20));
+    params_.affine =
+        initialApproximationNames.lookupOrDefault
+        (
+            "initialApproximation", dict, initialApproximation::affine
+        ) == initialApproximation::affine;
+    invertedCellsFatal_ =
+        onInvertedNames.lookupOrDefault("invertedCells", dict, onInverted::fatal)
+     == onInverted::fatal;
+    params_.bucketTiles =
+        dict.getCheckOrDefault<label>("bucketTiles", 32, labelMinMax::ge(1));
+}
+
+
+void Foam::multilevelBSplineMotionSolver::buildPlan()
+{
+    const boundaryConstraints& bc = *constraintsPtr_;
+    const labelList& dirs = bc.directions();
+    const label D = dirs.size();
+    const pointField& p0 = points0();
+
+    controlXyz_.clear();
+    for (const label pointi : bc.controlPoints())
+    {
+        for (const label d : dirs) controlXyz_.push_back(p0[pointi][d]);
+    }
+    plan3_.reset();
+    plan2_.reset();
+    try
+    {
+        if (D == 3)
+        {
+            // The evaluation points are points0 itself, not copied
+            const mba::pointsView<3> eval
+            (
+                reinterpret_cast<const double*>(p0.cdata()), std::size_t(p0.size())
+            );
+            evalXyz_.clear();
+            plan3_.reset
+            (
+                new mba::multilevel<3>
+                (
+                    comm_, params_, 3,
+                    mba::pointsView<3>(controlXyz_.data(), bc.controlPoints().size()),
+                    bc.mask(), eval
+                )
+            );
+        }
+        else if (D == 2)
+        {
+            evalXyz_.resize(2*p0.size());
+            forAll(p0, pointi)
+            {
+                evalXyz_[2*pointi] = p0[pointi][dirs[0]];
+                evalXyz_[2*pointi + 1] = p0[pointi][dirs[1]];
+            }
+            plan2_.reset
+            (
+                new mba::multilevel<2>
+                (
+                    comm_, params_, 2,
+                    mba::pointsView<2>(controlXyz_.data(), bc.controlPoints().size()),
+                    bc.mask(),
+                    mba::pointsView<2>(evalXyz_.data(), std::size_t(p0.size()))
+                )
+            );
+        }
+        else
+        {
+            FatalErrorInFunction
+                << "Meshes with " << D << " solution directions are not supported"
+                << " (2D or 3D only)" << exit(FatalError);
+        }
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction
+            << "Cannot set up the multilevel B-spline plan: " << e.what()
+            << exit(FatalError);
+    }
+    Info<< type() << ": plan for " << bc.nControlGlobal() << " control points, "
+        << returnReduce(p0.size(), sumOp<label>()) << " mesh points, " << D << "D"
+        << endl;
+}
+
+
+template<int D>
+void Foam::multilevelBSplineMotionSolver::morph
+(
+    mba::multilevel<D>& plan,
+    vectorField& displacement
+)
+{
+    const boundaryConstraints& bc = *constraintsPtr_;
+    const labelList& dirs = bc.directions();
+    const clockTime timer;
+    std::vector<double> out;
+    try
+    {
+        plan.fit(bc.values());
+        plan.evaluate(out);
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction
+            << "Multilevel B-spline fit failed: " << e.what() << exit(FatalError);
+    }
+    forAll(displacement, pointi)
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            displacement[pointi][dirs[k]] = out[pointi*D + k];
+        }
+    }
+
+    const mba::fitReport& r = plan.report();
+    double nodes = 0, bytes = 0;
+    for (const mba::levelStats& s : plan.stats())
+    {
+        if (s.level < r.levels)
+        {
+            nodes += s.nodes;
+            bytes += s.bytesReceivedPerApply;
+        }
+    }
+    nodes = returnReduce(nodes, sumOp<scalar>());
+    bytes = returnReduce(bytes, sumOp<scalar>());
+    Info<< type() << ": " << r.levels << " levels, max residual " << r.maxResidual
+        << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
+        << "), " << label(nodes) << " lattice nodes, " << label(bytes)
+        << " bytes exchanged, " << timer.elapsedTime() << " s" << endl;
+}
+
+
+Foam::label Foam::multilevelBSplineMotionSolver::nInvertedCells
+(
+    const pointField& points
+) const
+{
+    const cellList& cells = mesh().cells();
+    const faceList& faces = mesh().faces();
+    label n = 0;
+    forAll(cells, celli)
+    {
+        if (!(cells[celli].mag(points, faces) > 0))
+        {
+            ++n;
+        }
+    }
+    return returnReduce(n, sumOp<label>());
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::multilevelBSplineMotionSolver::multilevelBSplineMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict
+)
+:
+    displacementMotionSolver(mesh, dict, typeName)
+{
+    readCoeffs();
+}
+
+
+Foam::multilevelBSplineMotionSolver::multilevelBSplineMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict,
+    const pointVectorField& pointDisplacement,
+    const pointIOField& points0
+)
+:
+    displacementMotionSolver(mesh, dict, pointDisplacement, points0, typeName)
+{
+    readCoeffs();
+}
+
+
+// * * * * * * * * * * * * * * * * Destructor  * * * * * * * * * * * * * * * //
+
+Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::tmp<Foam::pointField>
+Foam::multilevelBSplineMotionSolver::curPoints() const
+{
+    tmp<pointField> tcurPoints(points0() + pointDisplacement_.primitiveField());
+    twoDCorrectPoints(tcurPoints.ref());
+    return tcurPoints;
+}
+
+
+void Foam::multilevelBSplineMotionSolver::solve()
+{
+    // The boundary conditions give the prescribed displacements
+    pointDisplacement_.boundaryFieldRef().updateCoeffs();
+    pointDisplacement_.correctBoundaryConditions();
+
+    std::unique_ptr<boundaryConstraints> bc
+    (
+        new boundaryConstraints(pointDisplacement_)
+    );
+
+    vectorField displacement(points0().size(), Zero);
+    if (bc->nControlGlobal() == 0)
+    {
+        WarningInFunction
+            << "No control points: no patch of pointDisplacement fixes a value"
+            << " or slides; the mesh keeps its initial points" << endl;
+        constraintsPtr_ = std::move(bc);
+        plan3_.reset();
+        plan2_.reset();
+    }
+    else
+    {
+        const bool changed =
+            !constraintsPtr_ || !bc->sameControls(*constraintsPtr_);
+        constraintsPtr_ = std::move(bc);
+        if (returnReduce(changed, orOp<bool>()) || (!plan3_ && !plan2_))
+        {
+            buildPlan();
+        }
+        if (plan3_) morph(*plan3_, displacement);
+        else morph(*plan2_, displacement);
+    }
+    constraintsPtr_->constrain(displacement);
+
+    const label nInverted = nInvertedCells(points0() + displacement);
+    if (nInverted > 0)
+    {
+        if (invertedCellsFatal_)
+        {
+            FatalErrorInFunction
+                << "The prescribed motion inverts " << nInverted
+                << " cells at time " << mesh().time().timeName()
+                << " (non-positive volume); the mesh is not moved."
+                << " Smaller steps, a finer initialGrid or invertedCells warn"
+                << " (to continue anyway) are the options" << exit(FatalError);
+        }
+        WarningInFunction
+            << "The morphed mesh has " << nInverted << " inverted cells at time "
+            << mesh().time().timeName() << endl;
+    }
+
+    pointDisplacement_.primitiveFieldRef() = displacement;
+    pointDisplacement_.correctBoundaryConditions();
+}
+
+
+void Foam::multilevelBSplineMotionSolver::updateMesh(const mapPolyMesh& mpm)
+{
+    displacementMotionSolver::updateMesh(mpm);
+    // points0 changed: the plan is rebuilt at the next solve
+    constraintsPtr_.reset();
+    plan3_.reset();
+    plan2_.reset();
+}
+
+
+// ************************************************************************* //
