@@ -19,6 +19,7 @@ ap.add_argument("--solver", default="multilevelBSpline")
 ap.add_argument("--pimple", action="store_true")
 ap.add_argument("--np", type=int, default=1)
 ap.add_argument("--end", type=int, default=3)
+ap.add_argument("--move", type=float, default=0.06, help="x displacement of the hole at t=3")
 a = ap.parse_args()
 
 X = [0.0, 0.35, 0.65, 1.0]
@@ -113,7 +114,7 @@ write("constant/dynamicMeshDict", "dictionary", "dynamicMeshDict",
       "dynamicFvMesh dynamicMotionSolverFvMesh;\nmotionSolverLibs %s;\nmotionSolver %s;\n%s" %
       (libs, a.solver, coeffs.get(a.solver, "")))
 
-move = "(0.06 0.03 0)" if a.twoD else "(0.06 0.03 0.015)"
+move = ("(%.17g 0.03 0)" if a.twoD else "(%.17g 0.03 0.015)") % a.move
 bc = {"hole": "type uniformFixedValue; uniformValue table ((0 (0 0 0)) (3 %s));" % move,
       "xMin": "type slip;", "xMax": "type slip;", "yMin": "type slip;", "yMax": "type slip;",
       "zMin": "type fixedValue; value uniform (0 0 0);", "zMax": "type fixedValue; value uniform (0 0 0);",

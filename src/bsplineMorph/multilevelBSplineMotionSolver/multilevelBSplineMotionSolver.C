@@ -212,12 +212,45 @@ Foam::label Foam::multilevelBSplineMotionSolver::nInvertedCells
     const pointField& points
 ) const
 {
-    const cellList& cells = mesh().cells();
+    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
+    // never sees an inverted cell): pyramids from each face to an estimated
+    // centre, signed by the face's orientation relative to the cell
     const faceList& faces = mesh().faces();
-    label n = 0;
-    forAll(cells, celli)
+    const labelList& own = mesh().faceOwner();
+    const labelList& nei = mesh().faceNeighbour();
+    const label nCells = mesh().nCells();
+    vectorField Cf(faces.size()), Sf(faces.size());
+    forAll(faces, facei)
     {
-        if (!(cells[celli].mag(points, faces) > 0))
+        Cf[facei] = faces[facei].centre(points);
+        Sf[facei] = faces[facei].areaNormal(points);
+    }
+    vectorField cEst(nCells, Zero);
+    scalarField nFaces(nCells, 0);
+    forAll(own, facei)
+    {
+        cEst[own[facei]] += Cf[facei];
+        nFaces[own[facei]] += 1;
+    }
+    forAll(nei, facei)
+    {
+        cEst[nei[facei]] += Cf[facei];
+        nFaces[nei[facei]] += 1;
+    }
+    cEst /= nFaces;
+    scalarField vol(nCells, 0);
+    forAll(own, facei)
+    {
+        vol[own[facei]] += Sf[facei] & (Cf[facei] - cEst[own[facei]]);
+    }
+    forAll(nei, facei)
+    {
+        vol[nei[facei]] -= Sf[facei] & (Cf[facei] - cEst[nei[facei]]);
+    }
+    label n = 0;
+    forAll(vol, celli)
+    {
+        if (!(vol[celli] > 0))
         {
             ++n;
         }
