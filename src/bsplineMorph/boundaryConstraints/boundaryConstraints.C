@@ -18,6 +18,7 @@ License
 #include "boundaryConstraints.H"
 #include "syncTools.H"
 #include "polyMesh.H"
+#include "facePointPatch.H"
 #include "OStringStream.H"
 #include "IStringStream.H"
 #include "HashOps.H"
@@ -123,12 +124,22 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
                 }
             }
         }
-        else if (pf.type() == "slip")
+        else if (pf.type() == "slip" || pp.constraintType() == "symmetry")
         {
-            const vectorField& n = pp.pointNormals();
-            forAll(meshPoints, i)
+            // Each face's own normal on each of its points, combined (plane,
+            // line, fixed): a patch spanning several planes (the faces of a
+            // box) constrains its edge points to the line where they meet.
+            // Averaged point normals would not: they tilt at edges and differ
+            // between the ranks that share a point.
+            const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
+            const vectorField& nf = patch.faceNormals();
+            const faceList& lf = patch.localFaces();
+            forAll(lf, facei)
             {
-                slide_[meshPoints[i]].applyConstraint(n[i]);
+                for (const label lp : lf[facei])
+                {
+                    slide_[meshPoints[lp]].applyConstraint(nf[facei]);
+                }
             }
         }
         else if (pf.type() == "fixedNormalSlip")
@@ -146,7 +157,7 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
         }
         else if (pp.constraintType() != word::null)
         {
-            // symmetryPlane, symmetry, wedge, cyclicSlip: the patch's own constraint
+            // symmetryPlane, wedge, cyclicSlip: the patch's own constraint
             forAll(meshPoints, i)
             {
                 pointConstraint pc;
