@@ -19,6 +19,7 @@ ap.add_argument("--solver", default="multilevelBSpline")
 ap.add_argument("--pimple", action="store_true")
 ap.add_argument("--np", type=int, default=1)
 ap.add_argument("--end", type=int, default=3)
+ap.add_argument("--merge-sides", action="store_true", help="one slip patch for the four x/y faces")
 ap.add_argument("--move", type=float, default=0.06, help="x displacement of the hole at t=3")
 a = ap.parse_args()
 
@@ -64,6 +65,9 @@ for c in blocks:
     if a.twoD:
         patches.setdefault("frontAndBack", [])
         patches["frontAndBack"] += [face(c, 2, 0), face(c, 2, 1)]
+
+if a.merge_sides and not a.twoD:
+    patches["sides"] = sum((patches.pop(k) for k in ["xMin", "xMax", "yMin", "yMax"]), [])
 
 os.makedirs(os.path.join(a.dir, "system"), exist_ok=True)
 os.makedirs(os.path.join(a.dir, "constant"), exist_ok=True)
@@ -118,7 +122,7 @@ move = ("(%.17g 0.03 0)" if a.twoD else "(%.17g 0.03 0.015)") % a.move
 bc = {"hole": "type uniformFixedValue; uniformValue table ((0 (0 0 0)) (3 %s));" % move,
       "xMin": "type slip;", "xMax": "type slip;", "yMin": "type slip;", "yMax": "type slip;",
       "zMin": "type fixedValue; value uniform (0 0 0);", "zMax": "type fixedValue; value uniform (0 0 0);",
-      "frontAndBack": "type empty;"}
+      "frontAndBack": "type empty;", "sides": "type slip;"}
 if a.twoD:
     bc["xMin"] = bc["xMax"] = "type fixedValue; value uniform (0 0 0);"
 body = "dimensions [0 1 0 0 0 0 0];\ninternalField uniform (0 0 0);\nboundaryField {\n"
