@@ -1,9 +1,11 @@
 #include "rbfInterpolant.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 
 extern "C" {
@@ -122,14 +124,27 @@ interpolant<D>::interpolant(const mba::communicator& comm, const params& p, int 
             gathered.push_back(x);
         }
     }
+    // Canonical order: sorted by coordinates quantised to 1e-10 of the
+    // bounding-box diagonal; points equal at that resolution are one centre
+    // (a 2D mesh's front and back points project to the same position, a few
+    // ulps apart: as two centres they would make the system singular)
+    mba::box<D> gb = mba::box<D>::empty();
+    for (const auto& x : gathered) gb.add(x.data());
+    double gdiag = 0;
+    if (!gb.isEmpty()) for (int d = 0; d < D; ++d) gdiag += (gb.hi[d] - gb.lo[d])*(gb.hi[d] - gb.lo[d]);
+    const double quantum = 1e-10*(gdiag > 0 ? std::sqrt(gdiag) : 1.0);
+    std::vector<std::array<std::int64_t, D>> key(gathered.size());
+    for (std::size_t i = 0; i < gathered.size(); ++i)
+        for (int d = 0; d < D; ++d) key[i][d] = std::int64_t(std::llround((gathered[i][d] - gb.lo[d])/quantum));
     std::vector<std::size_t> order(gathered.size());
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return gathered[a] < gathered[b]; });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return key[a] < key[b] || (key[a] == key[b] && gathered[a] < gathered[b]);
+    });
     std::vector<std::size_t> where(gathered.size());
     for (std::size_t k = 0; k < order.size(); ++k)
     {
-        // exact duplicates (a point listed twice) become one centre
-        if (!x_.empty() && gathered[order[k]] == x_.back()) { where[order[k]] = x_.size() - 1; continue; }
+        if (k > 0 && key[order[k]] == key[order[k - 1]]) { where[order[k]] = x_.size() - 1; continue; }
         where[order[k]] = x_.size();
         x_.push_back(gathered[order[k]]);
     }
@@ -214,11 +229,12 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
     stats_.rcond = rcond;
     stats_.bytes = double(lu_.size())*sizeof(double);
     collectively(comm_, [&] {
-        precondition(info == 0 && rcond >= p_.minRcond,
-            "rbf: the " + std::to_string(n) + "x" + std::to_string(n) + " " + kernelName(p_.function)
-            + " system is singular or ill-conditioned (reciprocal condition " + std::to_string(rcond)
-            + " < minRcond " + std::to_string(p_.minRcond) + "): duplicate or nearly coincident control"
-            " points, or a shape parameter / support radius far too large");
+        std::ostringstream msg;
+        msg << "rbf: the " << n << "x" << n << " " << kernelName(p_.function)
+            << " system is singular or ill-conditioned (reciprocal condition " << rcond
+            << " < minRcond " << p_.minRcond << "): duplicate or nearly coincident control"
+            " points, or shapeParameter / supportRadius far too large for the point spacing";
+        precondition(info == 0 && rcond >= p_.minRcond, msg.str());
     });
 }
 

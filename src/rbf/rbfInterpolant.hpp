@@ -8,7 +8,8 @@
 //
 // Parallel the way RBF morphers usually are: every rank gathers every control
 // point (through mba::communicator) and solves the same system. The gathered
-// points are put in a canonical order (sorted by coordinates), so the system,
+// points are put in a canonical order (sorted by coordinates; points that
+// coincide to 1e-10 of the bounding-box diagonal are one centre), so the system,
 // its solution and every evaluation are bitwise independent of the
 // decomposition. The dense symmetric system is factored once (LAPACK dsytrf)
 // per set of control points; each set of values is then one solve (dsytrs).

@@ -19,7 +19,7 @@ using namespace Foam;
 
 namespace
 {
-    autoPtr<motionSolver> bsplineSolver(const std::string& coeffs)
+    autoPtr<motionSolver> solverOf(const std::string& type, const std::string& coeffs)
     {
         IOdictionary dict
         (
@@ -36,18 +36,23 @@ namespace
             (
                 IStringStream
                 (
-                    "motionSolver multilevelBSpline; multilevelBSplineCoeffs {" + coeffs + "}"
+                    "motionSolver " + type + "; " + type + "Coeffs {" + coeffs + "}"
                 )()
             )
         );
         return motionSolver::New(bsmTest::mesh(), dict);
     }
 
-    std::string errorOf(const std::string& coeffs)
+    autoPtr<motionSolver> bsplineSolver(const std::string& coeffs)
+    {
+        return solverOf("multilevelBSpline", coeffs);
+    }
+
+    std::string errorOf(const std::string& coeffs, const std::string& type = "multilevelBSpline")
     {
         try
         {
-            bsplineSolver(coeffs);
+            solverOf(type, coeffs);
         }
         catch (const Foam::error& err)
         {
@@ -120,5 +125,38 @@ TEST_CASE("multilevelBSpline: a NaN displacement stops before the mesh moves", "
     catch (const Foam::error& err)
     {
         CHECK_THAT(std::string(err.message()), Catch::Matchers::Contains("non-finite") && Catch::Matchers::Contains("walls"));
+    }
+}
+
+
+TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][rbf][errors]")
+{
+    using Catch::Matchers::Contains;
+    const std::string function = errorOf("function gaussian;", "RBF");
+    CHECK_THAT(function, Contains("gaussian") && Contains("inverseMultiquadric")
+        && Contains("thinPlateSpline") && Contains("wendlandC2"));
+    CHECK_THAT(errorOf("shapeParameter 0;", "RBF"), Contains("shapeParameter"));
+    CHECK_THAT(errorOf("supportRadius -1;", "RBF"), Contains("supportRadius"));
+    CHECK_THAT(errorOf("maxPoints 0;", "RBF"), Contains("maxPoints"));
+    CHECK_THAT(errorOf("greedyTolerance -1;", "RBF"), Contains("greedyTolerance"));
+    CHECK_THAT(errorOf("greedyBatch 0;", "RBF"), Contains("greedyBatch"));
+    CHECK_THAT(errorOf("function thinPlateSpline; polynomial false;", "RBF"),
+        Contains("thinPlateSpline") && Contains("polynomial"));
+    CHECK_THAT(errorOf("invertedCells maybe;", "RBF"), Contains("maybe"));
+    CHECK(errorOf("function wendlandC2; supportRadius 2; polynomial false;", "RBF") == "no error");
+}
+
+
+TEST_CASE("RBF: the defaults keep a mesh whose walls are fixed at zero", "[foam][rbf]")
+{
+    autoPtr<motionSolver> solver = solverOf("RBF", "");
+    REQUIRE(solver.valid());
+    CHECK(solver->type() == "RBF");
+    solver->solve();
+    const pointField p1(solver->curPoints());
+    const pointField& p0 = bsmTest::mesh().points();
+    forAll(p0, pointi)
+    {
+        REQUIRE(mag(p1[pointi] - p0[pointi]) <= 1e-12);
     }
 }

@@ -16,10 +16,8 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "multilevelBSplineMotionSolver.H"
-#include "boundaryConstraints.H"
 #include "addToRunTimeSelectionTable.H"
 #include "Enum.H"
-#include "mapPolyMesh.H"
 #include "clockTime.H"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
@@ -51,12 +49,6 @@ namespace Foam
             { initialApproximation::none, "none" },
         });
 
-        enum class onInverted { fatal, warn };
-        const Enum<onInverted> onInvertedNames
-        ({
-            { onInverted::fatal, "fatal" },
-            { onInverted::warn, "warn" },
-        });
     }
 }
 
@@ -79,9 +71,6 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
         (
             "initialApproximation", dict, initialApproximation::affine
         ) == initialApproximation::affine;
-    invertedCellsFatal_ =
-        onInvertedNames.lookupOrDefault("invertedCells", dict, onInverted::fatal)
-     == onInverted::fatal;
     params_.bucketTiles =
         dict.getCheckOrDefault<label>("bucketTiles", 32, labelMinMax::ge(1));
 }
@@ -207,58 +196,6 @@ void Foam::multilevelBSplineMotionSolver::morph
 }
 
 
-Foam::label Foam::multilevelBSplineMotionSolver::nInvertedCells
-(
-    const pointField& points
-) const
-{
-    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
-    // never sees an inverted cell): pyramids from each face to an estimated
-    // centre, signed by the face's orientation relative to the cell
-    const faceList& faces = mesh().faces();
-    const labelList& own = mesh().faceOwner();
-    const labelList& nei = mesh().faceNeighbour();
-    const label nCells = mesh().nCells();
-    vectorField Cf(faces.size()), Sf(faces.size());
-    forAll(faces, facei)
-    {
-        Cf[facei] = faces[facei].centre(points);
-        Sf[facei] = faces[facei].areaNormal(points);
-    }
-    vectorField cEst(nCells, Zero);
-    scalarField nFaces(nCells, 0);
-    forAll(own, facei)
-    {
-        cEst[own[facei]] += Cf[facei];
-        nFaces[own[facei]] += 1;
-    }
-    forAll(nei, facei)
-    {
-        cEst[nei[facei]] += Cf[facei];
-        nFaces[nei[facei]] += 1;
-    }
-    cEst /= nFaces;
-    scalarField vol(nCells, 0);
-    forAll(own, facei)
-    {
-        vol[own[facei]] += Sf[facei] & (Cf[facei] - cEst[own[facei]]);
-    }
-    forAll(nei, facei)
-    {
-        vol[nei[facei]] -= Sf[facei] & (Cf[facei] - cEst[nei[facei]]);
-    }
-    label n = 0;
-    forAll(vol, celli)
-    {
-        if (!(vol[celli] > 0))
-        {
-            ++n;
-        }
-    }
-    return returnReduce(n, sumOp<label>());
-}
-
-
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::multilevelBSplineMotionSolver::multilevelBSplineMotionSolver
@@ -267,7 +204,7 @@ Foam::multilevelBSplineMotionSolver::multilevelBSplineMotionSolver
     const IOdictionary& dict
 )
 :
-    displacementMotionSolver(mesh, dict, typeName)
+    interpolatingMotionSolver(mesh, dict, typeName)
 {
     readCoeffs();
 }
@@ -281,7 +218,7 @@ Foam::multilevelBSplineMotionSolver::multilevelBSplineMotionSolver
     const pointIOField& points0
 )
 :
-    displacementMotionSolver(mesh, dict, pointDisplacement, points0, typeName)
+    interpolatingMotionSolver(mesh, dict, pointDisplacement, points0, typeName)
 {
     readCoeffs();
 }
@@ -295,79 +232,16 @@ Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-Foam::tmp<Foam::pointField>
-Foam::multilevelBSplineMotionSolver::curPoints() const
+void Foam::multilevelBSplineMotionSolver::interpolate(vectorField& displacement)
 {
-    tmp<pointField> tcurPoints(points0() + pointDisplacement_.primitiveField());
-    twoDCorrectPoints(tcurPoints.ref());
-    return tcurPoints;
-}
-
-
-void Foam::multilevelBSplineMotionSolver::solve()
-{
-    // The boundary conditions give the prescribed displacements
-    pointDisplacement_.boundaryFieldRef().updateCoeffs();
-    pointDisplacement_.correctBoundaryConditions();
-
-    std::unique_ptr<boundaryConstraints> bc
-    (
-        new boundaryConstraints(pointDisplacement_)
-    );
-
-    vectorField displacement(points0().size(), Zero);
-    if (bc->nControlGlobal() == 0)
+    if (plan3_)
     {
-        WarningInFunction
-            << "No control points: no patch of pointDisplacement fixes a value"
-            << " or slides; the mesh keeps its initial points" << endl;
-        constraintsPtr_ = std::move(bc);
-        plan3_.reset();
-        plan2_.reset();
+        morph(*plan3_, displacement);
     }
     else
     {
-        const bool changed =
-            !constraintsPtr_ || !bc->sameControls(*constraintsPtr_);
-        constraintsPtr_ = std::move(bc);
-        if (returnReduce(changed, orOp<bool>()) || (!plan3_ && !plan2_))
-        {
-            buildPlan();
-        }
-        if (plan3_) morph(*plan3_, displacement);
-        else morph(*plan2_, displacement);
+        morph(*plan2_, displacement);
     }
-    constraintsPtr_->constrain(displacement);
-
-    const label nInverted = nInvertedCells(points0() + displacement);
-    if (nInverted > 0)
-    {
-        if (invertedCellsFatal_)
-        {
-            FatalErrorInFunction
-                << "The prescribed motion inverts " << nInverted
-                << " cells at time " << mesh().time().timeName()
-                << " (non-positive volume); the mesh is not moved."
-                << " Smaller steps, a finer initialGrid or invertedCells warn"
-                << " (to continue anyway) are the options" << exit(FatalError);
-        }
-        WarningInFunction
-            << "The morphed mesh has " << nInverted << " inverted cells at time "
-            << mesh().time().timeName() << endl;
-    }
-
-    pointDisplacement_.primitiveFieldRef() = displacement;
-    pointDisplacement_.correctBoundaryConditions();
-}
-
-
-void Foam::multilevelBSplineMotionSolver::updateMesh(const mapPolyMesh& mpm)
-{
-    displacementMotionSolver::updateMesh(mpm);
-    // points0 changed: the plan is rebuilt at the next solve
-    constraintsPtr_.reset();
-    plan3_.reset();
-    plan2_.reset();
 }
 
 

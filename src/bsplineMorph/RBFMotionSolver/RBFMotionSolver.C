@@ -1,0 +1,228 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "RBFMotionSolver.H"
+#include "addToRunTimeSelectionTable.H"
+#include "Enum.H"
+#include "clockTime.H"
+
+// * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
+
+namespace Foam
+{
+    defineTypeNameAndDebug(RBFMotionSolver, 0);
+    addToRunTimeSelectionTable(motionSolver, RBFMotionSolver, dictionary);
+    addToRunTimeSelectionTable
+    (
+        displacementMotionSolver,
+        RBFMotionSolver,
+        displacement
+    );
+
+    namespace
+    {
+        const Enum<rbf::kernel> kernelNames
+        ({
+            { rbf::kernel::inverseMultiquadric, "inverseMultiquadric" },
+            { rbf::kernel::thinPlateSpline, "thinPlateSpline" },
+            { rbf::kernel::wendlandC2, "wendlandC2" },
+        });
+    }
+}
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+void Foam::RBFMotionSolver::readCoeffs()
+{
+    const dictionary& dict = coeffDict();
+    params_.function =
+        kernelNames.lookupOrDefault("function", dict, rbf::kernel::inverseMultiquadric);
+    params_.shapeParameter =
+        dict.getCheckOrDefault<scalar>("shapeParameter", 0.1, scalarMinMax::ge(SMALL));
+    params_.supportRadius =
+        dict.getCheckOrDefault<scalar>("supportRadius", 0.5, scalarMinMax::ge(SMALL));
+    params_.polynomial = dict.lookupOrDefault<bool>("polynomial", true);
+    params_.maxPoints =
+        dict.getCheckOrDefault<label>("maxPoints", 20000, labelMinMax::ge(1));
+    params_.greedyTolerance =
+        dict.getCheckOrDefault<scalar>("greedyTolerance", 0, scalarMinMax::ge(0));
+    params_.greedyBatch =
+        dict.getCheckOrDefault<label>("greedyBatch", 50, labelMinMax::ge(1));
+    if (params_.function == rbf::kernel::thinPlateSpline && !params_.polynomial)
+    {
+        FatalIOErrorInFunction(dict)
+            << "function thinPlateSpline needs polynomial true" << exit(FatalIOError);
+    }
+}
+
+
+template<int D>
+void Foam::RBFMotionSolver::interpolateD
+(
+    std::vector<std::unique_ptr<rbf::interpolant<D>>>& rbf,
+    vectorField& displacement
+)
+{
+    const boundaryConstraints& bc = *constraintsPtr_;
+    const labelList& dirs = bc.directions();
+    const clockTime timer;
+    const mba::pointsView<D> eval
+    (
+        D == 3 ? reinterpret_cast<const double*>(points0().cdata()) : evalXyz_.data(),
+        std::size_t(points0().size())
+    );
+    std::vector<double> values, out;
+    label size = 0;
+    scalar rcond = GREAT;
+    try
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            values.clear();
+            for (const label i : selected_[k]) values.push_back(bc.values()[i*D + k]);
+            rbf[k]->fit(values);
+            rbf[k]->evaluate(eval, out);
+            forAll(displacement, pointi)
+            {
+                displacement[pointi][dirs[k]] = out[pointi];
+            }
+            size = max(size, label(rbf[k]->stats().size));
+            rcond = min(rcond, rbf[k]->stats().rcond);
+        }
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction << "RBF interpolation failed: " << e.what() << exit(FatalError);
+    }
+    Info<< type() << ": " << D << " systems of size up to " << size
+        << ", reciprocal condition " << rcond << ", "
+        << timer.elapsedTime() << " s" << endl;
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::RBFMotionSolver::RBFMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict
+)
+:
+    interpolatingMotionSolver(mesh, dict, typeName)
+{
+    readCoeffs();
+}
+
+
+Foam::RBFMotionSolver::RBFMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict,
+    const pointVectorField& pointDisplacement,
+    const pointIOField& points0
+)
+:
+    interpolatingMotionSolver(mesh, dict, pointDisplacement, points0, typeName)
+{
+    readCoeffs();
+}
+
+
+// * * * * * * * * * * * * * * * * Destructor  * * * * * * * * * * * * * * * //
+
+Foam::RBFMotionSolver::~RBFMotionSolver()
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::RBFMotionSolver::buildPlan()
+{
+    const boundaryConstraints& bc = *constraintsPtr_;
+    const labelList& dirs = bc.directions();
+    const label D = dirs.size();
+    const pointField& p0 = points0();
+    const clockTime timer;
+
+    selected_.assign(D, {});
+    controlXyz_.assign(D, {});
+    forAll(bc.controlPoints(), i)
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            if (!bc.mask()[i*D + k]) continue;
+            selected_[k].push_back(i);
+            for (const label d : dirs)
+            {
+                controlXyz_[k].push_back(p0[bc.controlPoints()[i]][d]);
+            }
+        }
+    }
+    if (D == 2)
+    {
+        evalXyz_.resize(2*p0.size());
+        forAll(p0, pointi)
+        {
+            evalXyz_[2*pointi] = p0[pointi][dirs[0]];
+            evalXyz_[2*pointi + 1] = p0[pointi][dirs[1]];
+        }
+    }
+    rbf3_.clear();
+    rbf2_.clear();
+    try
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            const std::size_t n = selected_[k].size();
+            if (D == 3)
+            {
+                rbf3_.emplace_back(new rbf::interpolant<3>
+                    (comm_, params_, 1, mba::pointsView<3>(controlXyz_[k].data(), n)));
+            }
+            else
+            {
+                rbf2_.emplace_back(new rbf::interpolant<2>
+                    (comm_, params_, 1, mba::pointsView<2>(controlXyz_[k].data(), n)));
+            }
+        }
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction
+            << "Cannot set up the RBF systems: " << e.what() << exit(FatalError);
+    }
+    Info<< type() << ": " << kernelNames[params_.function] << " systems for "
+        << bc.nControlGlobal() << " control points factored in "
+        << timer.elapsedTime() << " s" << endl;
+}
+
+
+void Foam::RBFMotionSolver::interpolate(vectorField& displacement)
+{
+    if (!rbf3_.empty())
+    {
+        interpolateD(rbf3_, displacement);
+    }
+    else
+    {
+        interpolateD(rbf2_, displacement);
+    }
+}
+
+
+// ************************************************************************* //

@@ -1,0 +1,214 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "interpolatingMotionSolver.H"
+#include "Enum.H"
+#include "mapPolyMesh.H"
+
+// * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
+
+namespace Foam
+{
+    defineTypeNameAndDebug(interpolatingMotionSolver, 0);
+
+    namespace
+    {
+        enum class onInverted { fatal, warn };
+        const Enum<onInverted> onInvertedNames
+        ({
+            { onInverted::fatal, "fatal" },
+            { onInverted::warn, "warn" },
+        });
+
+        bool readInvertedCellsFatal(const dictionary& dict)
+        {
+            return onInvertedNames.lookupOrDefault
+            (
+                "invertedCells", dict, onInverted::fatal
+            ) == onInverted::fatal;
+        }
+    }
+}
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+Foam::label Foam::interpolatingMotionSolver::nInvertedCells
+(
+    const pointField& points
+) const
+{
+    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
+    // never sees an inverted cell): pyramids from each face to an estimated
+    // centre, signed by the face's orientation relative to the cell
+    const faceList& faces = mesh().faces();
+    const labelList& own = mesh().faceOwner();
+    const labelList& nei = mesh().faceNeighbour();
+    const label nCells = mesh().nCells();
+    vectorField Cf(faces.size()), Sf(faces.size());
+    forAll(faces, facei)
+    {
+        Cf[facei] = faces[facei].centre(points);
+        Sf[facei] = faces[facei].areaNormal(points);
+    }
+    vectorField cEst(nCells, Zero);
+    scalarField nFaces(nCells, 0);
+    forAll(own, facei)
+    {
+        cEst[own[facei]] += Cf[facei];
+        nFaces[own[facei]] += 1;
+    }
+    forAll(nei, facei)
+    {
+        cEst[nei[facei]] += Cf[facei];
+        nFaces[nei[facei]] += 1;
+    }
+    cEst /= nFaces;
+    scalarField vol(nCells, 0);
+    forAll(own, facei)
+    {
+        vol[own[facei]] += Sf[facei] & (Cf[facei] - cEst[own[facei]]);
+    }
+    forAll(nei, facei)
+    {
+        vol[nei[facei]] -= Sf[facei] & (Cf[facei] - cEst[nei[facei]]);
+    }
+    label n = 0;
+    forAll(vol, celli)
+    {
+        if (!(vol[celli] > 0))
+        {
+            ++n;
+        }
+    }
+    return returnReduce(n, sumOp<label>());
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::interpolatingMotionSolver::interpolatingMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict,
+    const word& type
+)
+:
+    displacementMotionSolver(mesh, dict, type),
+    invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    planned_(false)
+{}
+
+
+Foam::interpolatingMotionSolver::interpolatingMotionSolver
+(
+    const polyMesh& mesh,
+    const IOdictionary& dict,
+    const pointVectorField& pointDisplacement,
+    const pointIOField& points0,
+    const word& type
+)
+:
+    displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
+    invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    planned_(false)
+{}
+
+
+// * * * * * * * * * * * * * * * * Destructor  * * * * * * * * * * * * * * * //
+
+Foam::interpolatingMotionSolver::~interpolatingMotionSolver()
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::tmp<Foam::pointField>
+Foam::interpolatingMotionSolver::curPoints() const
+{
+    tmp<pointField> tcurPoints(points0() + pointDisplacement_.primitiveField());
+    twoDCorrectPoints(tcurPoints.ref());
+    return tcurPoints;
+}
+
+
+void Foam::interpolatingMotionSolver::solve()
+{
+    // The boundary conditions give the prescribed displacements
+    pointDisplacement_.boundaryFieldRef().updateCoeffs();
+    pointDisplacement_.correctBoundaryConditions();
+
+    std::unique_ptr<boundaryConstraints> bc
+    (
+        new boundaryConstraints(pointDisplacement_)
+    );
+
+    vectorField displacement(points0().size(), Zero);
+    if (bc->nControlGlobal() == 0)
+    {
+        WarningInFunction
+            << "No control points: no patch of pointDisplacement fixes a value"
+            << " or slides; the mesh keeps its initial points" << endl;
+        constraintsPtr_ = std::move(bc);
+        planned_ = false;
+    }
+    else
+    {
+        const bool changed =
+            !constraintsPtr_ || !bc->sameControls(*constraintsPtr_);
+        constraintsPtr_ = std::move(bc);
+        if (returnReduce(changed, orOp<bool>()) || !planned_)
+        {
+            buildPlan();
+            planned_ = true;
+        }
+        interpolate(displacement);
+    }
+    constraintsPtr_->constrain(displacement);
+
+    const label nInverted = nInvertedCells(points0() + displacement);
+    if (nInverted > 0)
+    {
+        if (invertedCellsFatal_)
+        {
+            FatalErrorInFunction
+                << "The prescribed motion inverts " << nInverted
+                << " cells at time " << mesh().time().timeName()
+                << " (non-positive volume); the mesh is not moved."
+                << " Smaller steps, a finer initialGrid or invertedCells warn"
+                << " (to continue anyway) are the options" << exit(FatalError);
+        }
+        WarningInFunction
+            << "The morphed mesh has " << nInverted << " inverted cells at time "
+            << mesh().time().timeName() << endl;
+    }
+
+    pointDisplacement_.primitiveFieldRef() = displacement;
+    pointDisplacement_.correctBoundaryConditions();
+}
+
+
+void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
+{
+    displacementMotionSolver::updateMesh(mpm);
+    // points0 changed: the plan is rebuilt at the next solve
+    constraintsPtr_.reset();
+    planned_ = false;
+}
+
+
+// ************************************************************************* //
