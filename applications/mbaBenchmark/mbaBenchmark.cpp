@@ -4,6 +4,7 @@
 //   mbaBenchmark [--case surface|volume] [--k K] [--n N] [--eval M]
 //                [--tolerance T] [--max-levels L] [--initial-grid G]
 //                [--seed S] [--dim 2|3] [--ranks R] [--no-affine]
+//                [--method mba|rbf] [--shape C]
 //
 // surface: k x k points on each face of the unit cube (N = 6k^2; in 2D k points
 // on each edge of the unit square), volume: N random points in the unit cube;
@@ -13,10 +14,12 @@
 // Prints the sizes, times and statistics, and ends with one key=value line.
 
 #include "multilevel.hpp"
+#include "rbfInterpolant.hpp"
 
 #include <sys/resource.h>
 
 #include <chrono>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -39,6 +42,8 @@ struct options
     int maxLevels = 16, initialGrid = 1, dim = 3, ranks = 1;
     unsigned seed = 1;
     bool affine = true;
+    std::string method = "mba";
+    double shape = 0.1;
 };
 
 [[noreturn]] void usage(const std::string& msg)
@@ -46,7 +51,7 @@ struct options
     std::cerr << "mbaBenchmark: " << msg << "\n"
         "usage: mbaBenchmark [--case surface|volume] [--k K] [--n N] [--eval M] [--tolerance T]\n"
         "                    [--max-levels L] [--initial-grid G] [--seed S] [--dim 2|3] [--ranks R]\n"
-        "                    [--no-affine]\n";
+        "                    [--no-affine] [--method mba|rbf] [--shape C]\n";
     std::exit(2);
 }
 
@@ -73,12 +78,15 @@ options parse(int argc, char** argv)
             else if (a == "--dim") o.dim = std::stoi(val());
             else if (a == "--ranks") o.ranks = std::stoi(val());
             else if (a == "--no-affine") o.affine = false;
+            else if (a == "--method") o.method = val();
+            else if (a == "--shape") o.shape = std::stod(val());
             else usage("unknown option " + a);
         }
         catch (const std::logic_error&) { usage("bad value for " + a); }
     }
     if (o.kase != "surface" && o.kase != "volume") usage("--case must be surface or volume");
     if (o.dim != 2 && o.dim != 3) usage("--dim must be 2 or 3");
+    if (o.method != "mba" && o.method != "rbf") usage("--method must be mba or rbf");
     if (o.k < 2 || o.n < 1 || o.eval < 0 || o.ranks < 1) usage("sizes must be positive (k >= 2)");
     return o;
 }
@@ -246,6 +254,53 @@ template <int D> int run(const options& o)
     return 0;
 }
 
+/// The RBF baseline (inverse multiquadric + linear polynomial, serial) on the
+/// same points and values: setup (gather, assemble, factor), apply (solve for
+/// new values), evaluation
+template <int D> int runRbf(const options& o)
+{
+    std::mt19937_64 rng(o.seed);
+    const std::vector<point<D>> ctrl = controlPoints<D>(o, rng);
+    std::vector<point<D>> ev(o.eval);
+    std::uniform_real_distribution<double> U(0, 1);
+    for (auto& x : ev) for (auto& c : x) c = U(rng);
+    std::cout << "mbaBenchmark: RBF (inverse multiquadric, shapeParameter " << o.shape
+              << ", linear polynomial), case " << o.kase << ", dim " << D << ", control points " << ctrl.size()
+              << ", evaluation points " << ev.size() << ", seed " << o.seed << std::endl;
+    std::vector<double> v1(ctrl.size()), v2(ctrl.size());
+    for (std::size_t i = 0; i < ctrl.size(); ++i) { v1[i] = field<D>(ctrl[i], 0.0); v2[i] = field<D>(ctrl[i], 0.7); }
+
+    rbf::params prm;
+    prm.shapeParameter = o.shape;
+    prm.maxPoints = 1000000;
+    const serialCommunicator comm;
+    const double mem0 = peakMB();
+    double t = seconds();
+    rbf::interpolant<D> s(comm, prm, 1, pointsView<D>(ctrl[0].data(), ctrl.size()));
+    const double tSetup = seconds() - t;
+    s.fit(v1);
+    t = seconds();
+    s.fit(v2);
+    const double tApply = seconds() - t;
+    std::vector<double> out, atCtrl;
+    t = seconds();
+    s.evaluate(pointsView<D>(ev[0].data(), ev.size()), out);
+    const double tEval = seconds() - t;
+    s.evaluate(pointsView<D>(ctrl[0].data(), ctrl.size()), atCtrl);
+    double maxRes = 0;
+    for (std::size_t i = 0; i < ctrl.size(); ++i) maxRes = std::max(maxRes, std::abs(atCtrl[i] - v2[i]));
+    const rbf::systemStats& st = s.stats();
+    std::printf("setup (gather, assemble, factor) %.4f s, apply %.4f s, evaluate %.4f s (%.2f M points/s)\n",
+                tSetup, tApply, tEval, o.eval/std::max(tEval, 1e-12)/1e6);
+    std::printf("system size %ld, reciprocal condition %.3e, max residual %.3e, factor %.1f MB, peak %.1f MB (%.1f before)\n",
+                st.size, st.rcond, maxRes, st.bytes/1048576.0, peakMB(), mem0);
+    std::printf("RESULT method=rbf case=%s dim=%d n_control=%zu n_eval=%ld setup_s=%.6f apply_s=%.6f eval_s=%.6f "
+                "size=%ld rcond=%.3e max_res=%.3e factor_mb=%.2f peak_mb=%.1f\n",
+                o.kase.c_str(), D, ctrl.size(), o.eval, tSetup, tApply, tEval, st.size, st.rcond, maxRes,
+                st.bytes/1048576.0, peakMB());
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -253,6 +308,7 @@ int main(int argc, char** argv)
     const options o = parse(argc, argv);
     try
     {
+        if (o.method == "rbf") return o.dim == 2 ? runRbf<2>(o) : runRbf<3>(o);
         return o.dim == 2 ? run<2>(o) : run<3>(o);
     }
     catch (const std::exception& e)

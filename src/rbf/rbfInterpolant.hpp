@@ -38,7 +38,7 @@ struct params
     /// Basis function
     kernel function = kernel::inverseMultiquadric;
     /// Inverse multiquadric c, relative to the control points' bounding-box diagonal (> 0)
-    double shapeParameter = 0.1;
+    double shapeParameter = 0.05;
     /// Wendland C2 support radius, relative to the bounding-box diagonal (> 0)
     double supportRadius = 0.5;
     /// Linear polynomial augmentation: affine motions reproduced exactly

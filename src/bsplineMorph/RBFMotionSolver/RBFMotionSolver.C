@@ -53,7 +53,7 @@ void Foam::RBFMotionSolver::readCoeffs()
     params_.function =
         kernelNames.lookupOrDefault("function", dict, rbf::kernel::inverseMultiquadric);
     params_.shapeParameter =
-        dict.getCheckOrDefault<scalar>("shapeParameter", 0.1, scalarMinMax::ge(SMALL));
+        dict.getCheckOrDefault<scalar>("shapeParameter", 0.05, scalarMinMax::ge(SMALL));
     params_.supportRadius =
         dict.getCheckOrDefault<scalar>("supportRadius", 0.5, scalarMinMax::ge(SMALL));
     params_.polynomial = dict.lookupOrDefault<bool>("polynomial", true);

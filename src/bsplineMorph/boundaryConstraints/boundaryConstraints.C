@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "boundaryConstraints.H"
+#include "valuePointPatchFields.H"
 #include "syncTools.H"
 #include "polyMesh.H"
 #include "facePointPatch.H"
@@ -114,13 +115,24 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
         }
         if (pf.fixesValue())
         {
-            for (const label pointi : meshPoints)
+            // The condition's own values (the internal field at a point on a
+            // fixed and a slip patch depends on their evaluation order)
+            const valuePointPatchVectorField* vpf =
+                isA<valuePointPatchVectorField>(pf);
+            const vectorField values
+            (
+                vpf
+              ? static_cast<const vectorField&>(*vpf)
+              : vectorField(disp, meshPoints)
+            );
+            forAll(meshPoints, i)
             {
+                const label pointi = meshPoints[i];
                 fixed[pointi] = 1;
-                value_[pointi] = disp[pointi];
+                value_[pointi] = values[i];
                 for (direction c = 0; c < 3; ++c)
                 {
-                    if (!std::isfinite(disp[pointi][c])) badPatches.insert(pp.name());
+                    if (!std::isfinite(values[i][c])) badPatches.insert(pp.name());
                 }
             }
         }

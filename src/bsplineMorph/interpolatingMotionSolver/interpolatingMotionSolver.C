@@ -189,16 +189,22 @@ void Foam::interpolatingMotionSolver::solve()
                 << "The prescribed motion inverts " << nInverted
                 << " cells at time " << mesh().time().timeName()
                 << " (non-positive volume); the mesh is not moved."
-                << " Smaller steps, a finer initialGrid or invertedCells warn"
-                << " (to continue anyway) are the options" << exit(FatalError);
+                << " Smaller motion steps, other " << type() << "Coeffs"
+                << " settings, or invertedCells warn (to continue anyway) are"
+                << " the options" << exit(FatalError);
         }
         WarningInFunction
             << "The morphed mesh has " << nInverted << " inverted cells at time "
             << mesh().time().timeName() << endl;
     }
 
+    // Evaluate the conditions (fixed values, processor patches), then keep
+    // the constrained interpolant: slip conditions would re-project their
+    // points with their own point normals, which on a rank hold only that
+    // rank's faces and so differ between decompositions
     pointDisplacement_.primitiveFieldRef() = displacement;
     pointDisplacement_.correctBoundaryConditions();
+    pointDisplacement_.primitiveFieldRef() = displacement;
 }
 
 
