@@ -139,6 +139,24 @@ template <int D> std::vector<point<D>> controlPoints(const options& o, std::mt19
     return p;
 }
 
+/// The benchmark problem: control points, random evaluation points (seeded),
+/// and two sets of control values (a fit, then an apply with new values)
+template <int D> struct problem
+{
+    std::vector<point<D>> ctrl, ev;
+    std::vector<double> v1, v2;
+
+    explicit problem(const options& o)
+    {
+        std::mt19937_64 rng(o.seed);
+        ctrl = controlPoints<D>(o, rng);
+        ev.resize(o.eval);
+        std::uniform_real_distribution<double> U(0, 1);
+        for (auto& x : ev) for (auto& c : x) c = U(rng);
+        for (const auto& x : ctrl) { v1.push_back(field<D>(x, 0.0)); v2.push_back(field<D>(x, 0.7)); }
+    }
+};
+
 struct result
 {
     int levels = 0;
@@ -150,11 +168,9 @@ struct result
 
 template <int D> int run(const options& o)
 {
-    std::mt19937_64 rng(o.seed);
-    const std::vector<point<D>> ctrl = controlPoints<D>(o, rng);
-    std::vector<point<D>> ev(o.eval);
-    std::uniform_real_distribution<double> U(0, 1);
-    for (auto& x : ev) for (auto& c : x) c = U(rng);
+    const problem<D> pb(o);
+    const std::vector<point<D>>& ctrl = pb.ctrl;
+    const std::vector<point<D>>& ev = pb.ev;
 
     std::cout << "mbaBenchmark: case " << o.kase << ", dim " << D << ", control points " << ctrl.size()
               << ", evaluation points " << ev.size() << ", tolerance " << o.tolerance << " (relative)"
@@ -177,8 +193,9 @@ template <int D> int run(const options& o)
         std::vector<point<D>> c, e;
         for (const auto& x : ctrl) if (slab(x) == comm.rank()) c.push_back(x);
         for (const auto& x : ev) if (slab(x) == comm.rank()) e.push_back(x);
-        std::vector<double> v1(c.size()), v2(c.size());
-        for (std::size_t i = 0; i < c.size(); ++i) { v1[i] = field<D>(c[i], 0.0); v2[i] = field<D>(c[i], 0.7); }
+        std::vector<double> v1, v2;
+        for (std::size_t i = 0; i < ctrl.size(); ++i)
+            if (slab(ctrl[i]) == comm.rank()) { v1.push_back(pb.v1[i]); v2.push_back(pb.v2[i]); }
 
         double t = seconds();
         std::unique_ptr<multilevel<D>> mba(new multilevel<D>(comm, prm, 1, c, {}, e));
@@ -259,17 +276,14 @@ template <int D> int run(const options& o)
 /// new values), evaluation
 template <int D> int runRbf(const options& o)
 {
-    std::mt19937_64 rng(o.seed);
-    const std::vector<point<D>> ctrl = controlPoints<D>(o, rng);
-    std::vector<point<D>> ev(o.eval);
-    std::uniform_real_distribution<double> U(0, 1);
-    for (auto& x : ev) for (auto& c : x) c = U(rng);
+    const problem<D> pb(o);
+    const std::vector<point<D>>& ctrl = pb.ctrl;
+    const std::vector<point<D>>& ev = pb.ev;
+    const std::vector<double>& v1 = pb.v1;
+    const std::vector<double>& v2 = pb.v2;
     std::cout << "mbaBenchmark: RBF (inverse multiquadric, shapeParameter " << o.shape
               << ", linear polynomial), case " << o.kase << ", dim " << D << ", control points " << ctrl.size()
               << ", evaluation points " << ev.size() << ", seed " << o.seed << std::endl;
-    std::vector<double> v1(ctrl.size()), v2(ctrl.size());
-    for (std::size_t i = 0; i < ctrl.size(); ++i) { v1[i] = field<D>(ctrl[i], 0.0); v2[i] = field<D>(ctrl[i], 0.7); }
-
     rbf::params prm;
     prm.shapeParameter = o.shape;
     prm.maxPoints = 1000000;

@@ -3,6 +3,8 @@
 
     checkPoints.py motion CASE TIME [--2d]   prescribed/sliding/fixed points
     checkPoints.py equal A B TIME [--tol T]  the points of two cases agree within T x domain size
+    checkPoints.py at CASE TIME X0 Y0 Z0 X1 Y1 Z1 [--tol T]
+                                             the point initially at X0 Y0 Z0 is at X1 Y1 Z1
 
 Exit status 1 on any failed check; prints what it measured.
 """
@@ -33,6 +35,15 @@ if mode == "equal":
     size = max(max(p[d] for p in p0) - min(p[d] for p in p0) for d in range(3))
     diff = max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
     check(diff <= tol*size, "largest difference %.3e <= %.1e x domain size %.3g" % (diff, tol, size))
+elif mode == "at":
+    case, time = sys.argv[2:4]
+    x0, x1 = [float(v) for v in sys.argv[4:7]], [float(v) for v in sys.argv[7:10]]
+    tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+    p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
+    i = min(range(len(p0)), key=lambda k: sum((p0[k][d] - x0[d])**2 for d in range(3)))
+    check(max(abs(p0[i][d] - x0[d]) for d in range(3)) < 1e-9, "a point at %s" % x0)
+    err = max(abs(p1[i][d] - x1[d]) for d in range(3))
+    check(err <= tol, "it moved to (%.12g %.12g %.12g), expected %s: error %.2e" % (p1[i] + (x1, err)))
 else:
     case, time = sys.argv[2:4]
     twoD = "--2d" in sys.argv

@@ -53,39 +53,50 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 ) const
 {
     // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
-    // never sees an inverted cell): pyramids from each face to an estimated
-    // centre, signed by the face's orientation relative to the cell
+    // never sees an inverted cell): the divergence theorem over the faces,
+    // each face as its vertex mean and its area vector (the triangles about
+    // its first vertex), relative to one vertex of the cell. Exact for planar
+    // faces; one pass over the faces, no square roots, no face arrays.
     const faceList& faces = mesh().faces();
     const labelList& own = mesh().faceOwner();
     const labelList& nei = mesh().faceNeighbour();
     const label nCells = mesh().nCells();
-    vectorField Cf(faces.size()), Sf(faces.size());
+    if (cellRefPoint_.size() != nCells)
+    {
+        cellRefPoint_.setSize(nCells, -1);
+        // (a cell may be the neighbour of all its faces)
+        forAll(own, facei)
+        {
+            if (cellRefPoint_[own[facei]] < 0) cellRefPoint_[own[facei]] = faces[facei][0];
+        }
+        forAll(nei, facei)
+        {
+            if (cellRefPoint_[nei[facei]] < 0) cellRefPoint_[nei[facei]] = faces[facei][0];
+        }
+    }
+    scalarField vol(nCells, 0);
     forAll(faces, facei)
     {
-        Cf[facei] = faces[facei].centre(points);
-        Sf[facei] = faces[facei].areaNormal(points);
-    }
-    vectorField cEst(nCells, Zero);
-    scalarField nFaces(nCells, 0);
-    forAll(own, facei)
-    {
-        cEst[own[facei]] += Cf[facei];
-        nFaces[own[facei]] += 1;
-    }
-    forAll(nei, facei)
-    {
-        cEst[nei[facei]] += Cf[facei];
-        nFaces[nei[facei]] += 1;
-    }
-    cEst /= nFaces;
-    scalarField vol(nCells, 0);
-    forAll(own, facei)
-    {
-        vol[own[facei]] += Sf[facei] & (Cf[facei] - cEst[own[facei]]);
-    }
-    forAll(nei, facei)
-    {
-        vol[nei[facei]] -= Sf[facei] & (Cf[facei] - cEst[nei[facei]]);
+        const face& f = faces[facei];
+        const point& p0 = points[f[0]];
+        vector sum = p0, area = Zero;
+        for (label i = 1; i < f.size(); ++i)
+        {
+            const point& p = points[f[i]];
+            sum += p;
+            if (i + 1 < f.size())
+            {
+                area += (p - p0) ^ (points[f[i + 1]] - p0);
+            }
+        }
+        const point mean = sum/f.size();
+        const label o = own[facei];
+        vol[o] += area & (mean - points[cellRefPoint_[o]]);
+        if (facei < nei.size())
+        {
+            const label c = nei[facei];
+            vol[c] -= area & (mean - points[cellRefPoint_[c]]);
+        }
     }
     label n = 0;
     forAll(vol, celli)
@@ -213,6 +224,7 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     displacementMotionSolver::updateMesh(mpm);
     // points0 changed: the plan is rebuilt at the next solve
     constraintsPtr_.reset();
+    cellRefPoint_.clear();
     planned_ = false;
 }
 

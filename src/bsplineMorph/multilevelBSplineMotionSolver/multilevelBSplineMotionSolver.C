@@ -188,11 +188,14 @@ void Foam::multilevelBSplineMotionSolver::morph
         }
     }
     nodes = returnReduce(nodes, sumOp<scalar>());
+    const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
     bytes = returnReduce(bytes, sumOp<scalar>());
+    const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
     Info<< type() << ": " << r.levels << " levels, max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
-        << "), " << label(nodes) << " lattice nodes, " << label(bytes)
-        << " bytes exchanged, " << timer.elapsedTime() << " s" << endl;
+        << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
+        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank)"
+        << ", " << timer.elapsedTime() << " s" << endl;
 }
 
 
