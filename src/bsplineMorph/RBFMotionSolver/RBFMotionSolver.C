@@ -78,7 +78,7 @@ void Foam::RBFMotionSolver::interpolateD
     vectorField& displacement
 )
 {
-    const boundaryConstraints& bc = *constraintsPtr_;
+    const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
     const clockTime timer;
     const mba::pointsView<D> eval
@@ -94,7 +94,7 @@ void Foam::RBFMotionSolver::interpolateD
         for (label k = 0; k < D; ++k)
         {
             values.clear();
-            for (const label i : selected_[k]) values.push_back(bc.values()[i*D + k]);
+            for (const label i : selected_[slot()][k]) values.push_back(bc.values()[i*D + k]);
             rbf[k]->fit(values);
             rbf[k]->evaluate(eval, out);
             forAll(displacement, pointi)
@@ -153,23 +153,23 @@ Foam::RBFMotionSolver::~RBFMotionSolver()
 
 void Foam::RBFMotionSolver::buildPlan()
 {
-    const boundaryConstraints& bc = *constraintsPtr_;
+    const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
     const label D = dirs.size();
     const pointField& p0 = points0();
     const clockTime timer;
 
-    selected_.assign(D, {});
-    controlXyz_.assign(D, {});
+    selected_[slot()].assign(D, {});
+    controlXyz_[slot()].assign(D, {});
     forAll(bc.controlPoints(), i)
     {
         for (label k = 0; k < D; ++k)
         {
             if (!bc.mask()[i*D + k]) continue;
-            selected_[k].push_back(i);
+            selected_[slot()][k].push_back(i);
             for (const label d : dirs)
             {
-                controlXyz_[k].push_back(p0[bc.controlPoints()[i]][d]);
+                controlXyz_[slot()][k].push_back(p0[bc.controlPoints()[i]][d]);
             }
         }
     }
@@ -182,22 +182,22 @@ void Foam::RBFMotionSolver::buildPlan()
             evalXyz_[2*pointi + 1] = p0[pointi][dirs[1]];
         }
     }
-    rbf3_.clear();
-    rbf2_.clear();
+    rbf3_[slot()].clear();
+    rbf2_[slot()].clear();
     try
     {
         for (label k = 0; k < D; ++k)
         {
-            const std::size_t n = selected_[k].size();
+            const std::size_t n = selected_[slot()][k].size();
             if (D == 3)
             {
-                rbf3_.emplace_back(new rbf::interpolant<3>
-                    (comm_, params_, 1, mba::pointsView<3>(controlXyz_[k].data(), n)));
+                rbf3_[slot()].emplace_back(new rbf::interpolant<3>
+                    (comm_, params_, 1, mba::pointsView<3>(controlXyz_[slot()][k].data(), n)));
             }
             else
             {
-                rbf2_.emplace_back(new rbf::interpolant<2>
-                    (comm_, params_, 1, mba::pointsView<2>(controlXyz_[k].data(), n)));
+                rbf2_[slot()].emplace_back(new rbf::interpolant<2>
+                    (comm_, params_, 1, mba::pointsView<2>(controlXyz_[slot()][k].data(), n)));
             }
         }
     }
@@ -214,13 +214,13 @@ void Foam::RBFMotionSolver::buildPlan()
 
 void Foam::RBFMotionSolver::interpolate(vectorField& displacement)
 {
-    if (!rbf3_.empty())
+    if (!rbf3_[slot()].empty())
     {
-        interpolateD(rbf3_, displacement);
+        interpolateD(rbf3_[slot()], displacement);
     }
     else
     {
-        interpolateD(rbf2_, displacement);
+        interpolateD(rbf2_[slot()], displacement);
     }
 }
 

@@ -202,7 +202,12 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     {
         fixed_[pointi] = fixed[pointi] != 0;
     }
+    collectControls();
+}
 
+
+void Foam::boundaryConstraints::collectControls()
+{
     // Control points in the solution directions
     const label nd = directions_.size();
     DynamicList<label> ctrl, proj;
@@ -245,9 +250,37 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
 }
 
 
+Foam::boundaryConstraints::boundaryConstraints
+(
+    const boundaryConstraints& bc,
+    const vectorField& displacement
+)
+:
+    pMesh_(bc.pMesh_),
+    directions_(bc.directions_),
+    fixed_(bc.fixed_),
+    value_(bc.value_),
+    slide_(bc.slide_),
+    owned_(bc.owned_)
+{
+    for (const label pointi : bc.projected_)
+    {
+        fixed_[pointi] = true;
+        value_[pointi] = displacement[pointi];
+    }
+    collectControls();
+}
+
+
 Foam::label Foam::boundaryConstraints::nControlGlobal() const
 {
     return returnReduce(controlPoints_.size(), sumOp<label>());
+}
+
+
+Foam::label Foam::boundaryConstraints::nProjectedGlobal() const
+{
+    return returnReduce(projected_.size(), sumOp<label>());
 }
 
 

@@ -121,7 +121,8 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    planned_(false)
+    planned_{false, false},
+    slot_(0)
 {}
 
 
@@ -136,7 +137,8 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    planned_(false)
+    planned_{false, false},
+    slot_(0)
 {}
 
 
@@ -169,25 +171,49 @@ void Foam::interpolatingMotionSolver::solve()
     );
 
     vectorField displacement(points0().size(), Zero);
+    slot_ = 0;
     if (bc->nControlGlobal() == 0)
     {
         WarningInFunction
             << "No control points: no patch of pointDisplacement fixes a value"
             << " or slides; the mesh keeps its initial points" << endl;
         constraintsPtr_ = std::move(bc);
-        planned_ = false;
+        clearPlan();
     }
     else
     {
         const bool changed =
             !constraintsPtr_ || !bc->sameControls(*constraintsPtr_);
         constraintsPtr_ = std::move(bc);
-        if (returnReduce(changed, orOp<bool>()) || !planned_)
+        if (returnReduce(changed, orOp<bool>()) || !planned_[0])
         {
             buildPlan();
-            planned_ = true;
+            planned_[0] = true;
         }
         interpolate(displacement);
+
+        // Sliding planes not along the axes: project, then fit again with
+        // the projected points as control points, so that the interpolant
+        // (not only those points) follows the planes
+        if (constraintsPtr_->nProjectedGlobal() > 0)
+        {
+            constraintsPtr_->constrain(displacement);
+            std::unique_ptr<boundaryConstraints> refit
+            (
+                new boundaryConstraints(*constraintsPtr_, displacement)
+            );
+            const bool refitChanged =
+                !refitPtr_ || !refit->sameControls(*refitPtr_);
+            refitPtr_ = std::move(refit);
+            slot_ = 1;
+            if (returnReduce(refitChanged, orOp<bool>()) || !planned_[1])
+            {
+                buildPlan();
+                planned_[1] = true;
+            }
+            interpolate(displacement);
+            slot_ = 0;
+        }
     }
     constraintsPtr_->constrain(displacement);
 
@@ -224,8 +250,9 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     displacementMotionSolver::updateMesh(mpm);
     // points0 changed: the plan is rebuilt at the next solve
     constraintsPtr_.reset();
+    refitPtr_.reset();
     cellRefPoint_.clear();
-    planned_ = false;
+    clearPlan();
 }
 
 

@@ -78,18 +78,22 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
 
 void Foam::multilevelBSplineMotionSolver::buildPlan()
 {
-    const boundaryConstraints& bc = *constraintsPtr_;
+    const boundaryConstraints& bc = constraints();
+    std::vector<double>& controlXyz = controlXyz_[slot()];
+    std::vector<double>& evalXyz = evalXyz_[slot()];
+    std::unique_ptr<mba::multilevel<3>>& plan3 = plan3_[slot()];
+    std::unique_ptr<mba::multilevel<2>>& plan2 = plan2_[slot()];
     const labelList& dirs = bc.directions();
     const label D = dirs.size();
     const pointField& p0 = points0();
 
-    controlXyz_.clear();
+    controlXyz.clear();
     for (const label pointi : bc.controlPoints())
     {
-        for (const label d : dirs) controlXyz_.push_back(p0[pointi][d]);
+        for (const label d : dirs) controlXyz.push_back(p0[pointi][d]);
     }
-    plan3_.reset();
-    plan2_.reset();
+    plan3.reset();
+    plan2.reset();
     try
     {
         if (D == 3)
@@ -99,33 +103,33 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
             (
                 reinterpret_cast<const double*>(p0.cdata()), std::size_t(p0.size())
             );
-            evalXyz_.clear();
-            plan3_.reset
+            evalXyz.clear();
+            plan3.reset
             (
                 new mba::multilevel<3>
                 (
                     comm_, params_, 3,
-                    mba::pointsView<3>(controlXyz_.data(), bc.controlPoints().size()),
+                    mba::pointsView<3>(controlXyz.data(), bc.controlPoints().size()),
                     bc.mask(), eval
                 )
             );
         }
         else if (D == 2)
         {
-            evalXyz_.resize(2*p0.size());
+            evalXyz.resize(2*p0.size());
             forAll(p0, pointi)
             {
-                evalXyz_[2*pointi] = p0[pointi][dirs[0]];
-                evalXyz_[2*pointi + 1] = p0[pointi][dirs[1]];
+                evalXyz[2*pointi] = p0[pointi][dirs[0]];
+                evalXyz[2*pointi + 1] = p0[pointi][dirs[1]];
             }
-            plan2_.reset
+            plan2.reset
             (
                 new mba::multilevel<2>
                 (
                     comm_, params_, 2,
-                    mba::pointsView<2>(controlXyz_.data(), bc.controlPoints().size()),
+                    mba::pointsView<2>(controlXyz.data(), bc.controlPoints().size()),
                     bc.mask(),
-                    mba::pointsView<2>(evalXyz_.data(), std::size_t(p0.size()))
+                    mba::pointsView<2>(evalXyz.data(), std::size_t(p0.size()))
                 )
             );
         }
@@ -142,7 +146,8 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
             << "Cannot set up the multilevel B-spline plan: " << e.what()
             << exit(FatalError);
     }
-    Info<< type() << ": plan for " << bc.nControlGlobal() << " control points, "
+    Info<< type() << ": " << (slot() ? "re-fit " : "") << "plan for "
+        << bc.nControlGlobal() << " control points, "
         << returnReduce(p0.size(), sumOp<label>()) << " mesh points, " << D << "D"
         << endl;
 }
@@ -155,7 +160,7 @@ void Foam::multilevelBSplineMotionSolver::morph
     vectorField& displacement
 )
 {
-    const boundaryConstraints& bc = *constraintsPtr_;
+    const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
     const clockTime timer;
     std::vector<double> out;
@@ -191,7 +196,7 @@ void Foam::multilevelBSplineMotionSolver::morph
     const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
     bytes = returnReduce(bytes, sumOp<scalar>());
     const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
-    Info<< type() << ": " << r.levels << " levels, max residual " << r.maxResidual
+    Info<< type() << ": " << (slot() ? "re-fit, " : "") << r.levels << " levels, max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank)"
@@ -237,13 +242,13 @@ Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
 
 void Foam::multilevelBSplineMotionSolver::interpolate(vectorField& displacement)
 {
-    if (plan3_)
+    if (plan3_[slot()])
     {
-        morph(*plan3_, displacement);
+        morph(*plan3_[slot()], displacement);
     }
     else
     {
-        morph(*plan2_, displacement);
+        morph(*plan2_[slot()], displacement);
     }
 }
 
