@@ -245,6 +245,13 @@ void Foam::interpolatingMotionSolver::solve()
 }
 
 
+void Foam::interpolatingMotionSolver::movePoints(const pointField& p)
+{
+    displacementMotionSolver::movePoints(p);
+    clearPlan();
+}
+
+
 void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
 {
     displacementMotionSolver::updateMesh(mpm);
