@@ -175,37 +175,39 @@ bool evalStencil(const tileLayout<3>& L, const double* phi, const stencil<3>& st
 {
     constexpr int npt = tileLayout<3>::nodesPerTile;
     const split1 x(st.base[0]), y(st.base[1]), z(st.base[2]);
-    double wyz[4][4];
-    for (int b = 0; b < 4; ++b)
-        for (int c = 0; c < 4; ++c) wyz[b][c] = st.w[1][b]*st.w[2][c];
-    double acc[NC] = {};
+    // The (up to 8) tiles first, then one regular 4 x 4 x 4 sweep
+    std::int64_t tid[8];
     bool any = false;
     for (int i = 0; i < x.nt; ++i)
         for (int j = 0; j < y.nt; ++j)
             for (int k = 0; k < z.nt; ++k)
             {
                 const std::int64_t id = L.find(index<3>{{x.t0 + i, y.t0 + j, z.t0 + k}});
-                if (id < 0) continue;
-                any = true;
-                const double* T = phi + id*npt*NC;
-                for (int a = x.r[i]; a < x.r[i + 1]; ++a)
-                {
-                    const double wa = st.w[0][a];
-                    const int oa = x.oa[a]*tileEdge;
-                    for (int b = y.r[j]; b < y.r[j + 1]; ++b)
-                    {
-                        const double* row = T + (oa + y.oa[b])*tileEdge*NC;
-                        for (int c = z.r[k]; c < z.r[k + 1]; ++c)
-                        {
-                            const double w = wa*wyz[b][c];
-                            const double* p = row + z.oa[c]*NC;
-                            for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
-                        }
-                    }
-                }
+                tid[(i*2 + j)*2 + k] = id;
+                any = any || id >= 0;
             }
+    if (!any) return false;
+    double acc[NC] = {};
+    for (int a = 0; a < 4; ++a)
+    {
+        const int ia = x.ta[a]*2, oa = x.oa[a]*tileEdge;
+        const double wa = st.w[0][a];
+        for (int b = 0; b < 4; ++b)
+        {
+            const int iab = (ia + y.ta[b])*2, oab = (oa + y.oa[b])*tileEdge;
+            const double wab = wa*st.w[1][b];
+            for (int c = 0; c < 4; ++c)
+            {
+                const std::int64_t id = tid[iab + z.ta[c]];
+                if (id < 0) continue;
+                const double w = wab*st.w[2][c];
+                const double* p = phi + (id*npt + oab + z.oa[c])*NC;
+                for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
+            }
+        }
+    }
     for (int v = 0; v < NC; ++v) out[v] += acc[v];
-    return any;
+    return true;
 }
 
 template <int NC>
