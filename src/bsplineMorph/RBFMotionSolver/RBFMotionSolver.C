@@ -17,6 +17,7 @@ License
 
 #include "RBFMotionSolver.H"
 #include "addToRunTimeSelectionTable.H"
+#include "OStringStream.H"
 #include "Enum.H"
 #include "clockTime.H"
 
@@ -72,7 +73,7 @@ void Foam::RBFMotionSolver::readCoeffs()
 
 
 template<int D>
-void Foam::RBFMotionSolver::interpolateD
+std::string Foam::RBFMotionSolver::interpolateD
 (
     std::vector<std::unique_ptr<rbf::interpolant<D>>>& rbf,
     vectorField& displacement
@@ -80,7 +81,6 @@ void Foam::RBFMotionSolver::interpolateD
 {
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
-    const clockTime timer;
     const mba::pointsView<D> eval
     (
         D == 3 ? reinterpret_cast<const double*>(points0().cdata()) : evalXyz_.data(),
@@ -109,9 +109,10 @@ void Foam::RBFMotionSolver::interpolateD
     {
         FatalErrorInFunction << "RBF interpolation failed: " << e.what() << exit(FatalError);
     }
-    Info<< type() << ": " << D << " systems of size up to " << size
-        << ", reciprocal condition " << rcond << ", "
-        << timer.elapsedTime() << " s" << endl;
+    OStringStream os;
+    os  << D << " systems of size up to " << size
+        << ", reciprocal condition " << rcond;
+    return os.str();
 }
 
 
@@ -212,16 +213,13 @@ void Foam::RBFMotionSolver::buildPlan()
 }
 
 
-void Foam::RBFMotionSolver::interpolate(vectorField& displacement)
+std::string Foam::RBFMotionSolver::interpolate(vectorField& displacement)
 {
     if (!rbf3_[slot()].empty())
     {
-        interpolateD(rbf3_[slot()], displacement);
+        return interpolateD(rbf3_[slot()], displacement);
     }
-    else
-    {
-        interpolateD(rbf2_[slot()], displacement);
-    }
+    return interpolateD(rbf2_[slot()], displacement);
 }
 
 

@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "interpolatingMotionSolver.H"
+#include "clockTime.H"
 #include "Enum.H"
 #include "mapPolyMesh.H"
 
@@ -161,6 +162,9 @@ Foam::interpolatingMotionSolver::curPoints() const
 
 void Foam::interpolatingMotionSolver::solve()
 {
+    const clockTime timer;
+    std::string summary;
+
     // The boundary conditions give the prescribed displacements
     pointDisplacement_.boundaryFieldRef().updateCoeffs();
     pointDisplacement_.correctBoundaryConditions();
@@ -190,7 +194,7 @@ void Foam::interpolatingMotionSolver::solve()
             buildPlan();
             planned_[0] = true;
         }
-        interpolate(displacement);
+        summary = interpolate(displacement);
 
         // Sliding planes not along the axes: project, then fit again with
         // the projected points as control points, so that the interpolant
@@ -211,7 +215,7 @@ void Foam::interpolatingMotionSolver::solve()
                 buildPlan();
                 planned_[1] = true;
             }
-            interpolate(displacement);
+            summary += "; re-fit with the projected sliding points: " + interpolate(displacement);
             slot_ = 0;
         }
     }
@@ -242,6 +246,12 @@ void Foam::interpolatingMotionSolver::solve()
     pointDisplacement_.primitiveFieldRef() = displacement;
     pointDisplacement_.correctBoundaryConditions();
     pointDisplacement_.primitiveFieldRef() = displacement;
+
+    if (!summary.empty())
+    {
+        Info<< type() << ": " << summary.c_str() << ", "
+            << timer.elapsedTime() << " s" << endl;
+    }
 }
 
 

@@ -17,6 +17,7 @@ License
 
 #include "multilevelBSplineMotionSolver.H"
 #include "addToRunTimeSelectionTable.H"
+#include "OStringStream.H"
 #include "Enum.H"
 #include "clockTime.H"
 
@@ -154,7 +155,7 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
 
 
 template<int D>
-void Foam::multilevelBSplineMotionSolver::morph
+std::string Foam::multilevelBSplineMotionSolver::morph
 (
     mba::multilevel<D>& plan,
     vectorField& displacement
@@ -162,7 +163,6 @@ void Foam::multilevelBSplineMotionSolver::morph
 {
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
-    const clockTime timer;
     std::vector<double> out;
     try
     {
@@ -196,11 +196,12 @@ void Foam::multilevelBSplineMotionSolver::morph
     const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
     bytes = returnReduce(bytes, sumOp<scalar>());
     const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
-    Info<< type() << ": " << (slot() ? "re-fit, " : "") << r.levels << " levels, max residual " << r.maxResidual
+    OStringStream os;
+    os  << r.levels << " levels, max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
-        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank)"
-        << ", " << timer.elapsedTime() << " s" << endl;
+        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank)";
+    return os.str();
 }
 
 
@@ -240,16 +241,16 @@ Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-void Foam::multilevelBSplineMotionSolver::interpolate(vectorField& displacement)
+std::string Foam::multilevelBSplineMotionSolver::interpolate
+(
+    vectorField& displacement
+)
 {
     if (plan3_[slot()])
     {
-        morph(*plan3_[slot()], displacement);
+        return morph(*plan3_[slot()], displacement);
     }
-    else
-    {
-        morph(*plan2_[slot()], displacement);
-    }
+    return morph(*plan2_[slot()], displacement);
 }
 
 
