@@ -19,7 +19,6 @@
 #include <sys/resource.h>
 
 #include <chrono>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>

@@ -81,11 +81,7 @@ std::string Foam::RBFMotionSolver::interpolateD
 {
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
-    const mba::pointsView<D> eval
-    (
-        D == 3 ? reinterpret_cast<const double*>(points0().cdata()) : evalXyz_.data(),
-        std::size_t(points0().size())
-    );
+    const mba::pointsView<D> eval(evalCoordinates(), std::size_t(points0().size()));
     std::vector<double> values, out;
     label size = 0;
     scalar rcond = GREAT;
@@ -172,15 +168,6 @@ void Foam::RBFMotionSolver::buildPlan()
             {
                 controlXyz_[slot()][k].push_back(p0[bc.controlPoints()[i]][d]);
             }
-        }
-    }
-    if (D == 2)
-    {
-        evalXyz_.resize(2*p0.size());
-        forAll(p0, pointi)
-        {
-            evalXyz_[2*pointi] = p0[pointi][dirs[0]];
-            evalXyz_[2*pointi + 1] = p0[pointi][dirs[1]];
         }
     }
     rbf3_[slot()].clear();

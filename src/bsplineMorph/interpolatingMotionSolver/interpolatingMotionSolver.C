@@ -111,6 +111,26 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 }
 
 
+const double* Foam::interpolatingMotionSolver::evalCoordinates() const
+{
+    const labelList& dirs = constraintsPtr_->directions();
+    const pointField& p0 = points0();
+    if (dirs.size() == 3)
+    {
+        return reinterpret_cast<const double*>(p0.cdata());
+    }
+    if (evalXyz_.size() != std::size_t(dirs.size()*p0.size()))
+    {
+        evalXyz_.clear();
+        for (const point& p : p0)
+        {
+            for (const label d : dirs) evalXyz_.push_back(p[d]);
+        }
+    }
+    return evalXyz_.data();
+}
+
+
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::interpolatingMotionSolver::interpolatingMotionSolver
@@ -269,6 +289,7 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     constraintsPtr_.reset();
     refitPtr_.reset();
     cellRefPoint_.clear();
+    evalXyz_.clear();
     clearPlan();
 }
 

@@ -81,7 +81,6 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
 {
     const boundaryConstraints& bc = constraints();
     std::vector<double>& controlXyz = controlXyz_[slot()];
-    std::vector<double>& evalXyz = evalXyz_[slot()];
     std::unique_ptr<mba::multilevel<3>>& plan3 = plan3_[slot()];
     std::unique_ptr<mba::multilevel<2>>& plan2 = plan2_[slot()];
     const labelList& dirs = bc.directions();
@@ -97,40 +96,28 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
     plan2.reset();
     try
     {
+        const std::size_t nEval = p0.size();
         if (D == 3)
         {
-            // The evaluation points are points0 itself, not copied
-            const mba::pointsView<3> eval
-            (
-                reinterpret_cast<const double*>(p0.cdata()), std::size_t(p0.size())
-            );
-            evalXyz.clear();
             plan3.reset
             (
                 new mba::multilevel<3>
                 (
                     comm_, params_, 3,
                     mba::pointsView<3>(controlXyz.data(), bc.controlPoints().size()),
-                    bc.mask(), eval
+                    bc.mask(), mba::pointsView<3>(evalCoordinates(), nEval)
                 )
             );
         }
         else if (D == 2)
         {
-            evalXyz.resize(2*p0.size());
-            forAll(p0, pointi)
-            {
-                evalXyz[2*pointi] = p0[pointi][dirs[0]];
-                evalXyz[2*pointi + 1] = p0[pointi][dirs[1]];
-            }
             plan2.reset
             (
                 new mba::multilevel<2>
                 (
                     comm_, params_, 2,
                     mba::pointsView<2>(controlXyz.data(), bc.controlPoints().size()),
-                    bc.mask(),
-                    mba::pointsView<2>(evalXyz.data(), std::size_t(p0.size()))
+                    bc.mask(), mba::pointsView<2>(evalCoordinates(), nEval)
                 )
             );
         }
