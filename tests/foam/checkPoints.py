@@ -6,7 +6,9 @@
     checkPoints.py at CASE TIME X0 Y0 Z0 X1 Y1 Z1 [--tol T]
                                              the point initially at X0 Y0 Z0 is at X1 Y1 Z1
 
-Exit status 1 on any failed check; prints what it measured.
+Exit status 1 on any failed check; prints what it measured. Other test scripts
+import it for readPoints, readLabels, pointsAt and check (run from the project's
+top folder: sys.path.insert(0, "tests/foam")).
 """
 import re, sys
 
@@ -15,6 +17,11 @@ def readPoints(path):
     body = txt[txt.index("(", txt.index("}")) :]
     nums = re.findall(r"\(([^()]+)\)", body)
     return [tuple(float(v) for v in s.split()) for s in nums]
+
+def readLabels(path):
+    """An ascii labelList (e.g. decomposePar's pointProcAddressing)"""
+    txt = open(path).read()
+    return [int(v) for v in txt[txt.index("(", txt.index("}")) + 1:txt.rindex(")")].split()]
 
 def pointsAt(case, time):
     return readPoints("%s/%s/polyMesh/points" % (case, time) if time != "constant" else "%s/constant/polyMesh/points" % case)
@@ -25,61 +32,65 @@ def check(cond, msg):
     if not cond:
         failures.append(msg)
 
-mode = sys.argv[1]
-if mode == "equal":
-    a, b, time = sys.argv[2:5]
-    tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
-    pa, pb = pointsAt(a, time), pointsAt(b, time)
-    check(len(pa) == len(pb), "same number of points (%d, %d)" % (len(pa), len(pb)))
-    p0 = pointsAt(a, "constant")
-    size = max(max(p[d] for p in p0) - min(p[d] for p in p0) for d in range(3))
-    diff = max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
-    check(diff <= tol*size, "largest difference %.3e <= %.1e x domain size %.3g" % (diff, tol, size))
-elif mode == "at":
-    case, time = sys.argv[2:4]
-    x0, x1 = [float(v) for v in sys.argv[4:7]], [float(v) for v in sys.argv[7:10]]
-    tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
-    p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
-    i = min(range(len(p0)), key=lambda k: sum((p0[k][d] - x0[d])**2 for d in range(3)))
-    check(max(abs(p0[i][d] - x0[d]) for d in range(3)) < 1e-9, "a point at %s" % x0)
-    err = max(abs(p1[i][d] - x1[d]) for d in range(3))
-    check(err <= tol, "it moved to (%.12g %.12g %.12g), expected %s: error %.2e" % (p1[i] + (x1, err)))
-else:
-    case, time = sys.argv[2:4]
-    twoD = "--2d" in sys.argv
-    p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
-    t = float(time)
-    move = [0.06*t/3, 0.03*t/3, 0.0 if twoD else 0.015*t/3]
-    hole = cube = slipErr = fixedErr = holeErr = zErr = 0.0
-    nHole = nSlip = nFixed = 0
-    for a, b in zip(p0, p1):
-        d = [b[k] - a[k] for k in range(3)]
-        inf = max(abs(a[0] - 0.5), abs(a[1] - 0.5))
-        if not twoD:
-            inf = max(inf, abs(a[2] - 0.5))
-        if abs(inf - 0.15) < 1e-12:
-            nHole += 1
-            holeErr = max(holeErr, max(abs(d[k] - move[k]) for k in range(3)))
-        if twoD:
-            zErr = max(zErr, abs(d[2]))
-            for k in (0,):   # x faces fixed in 2D
-                if a[k] in (0.0, 1.0):
+def main():
+    mode = sys.argv[1]
+    if mode == "equal":
+        a, b, time = sys.argv[2:5]
+        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        pa, pb = pointsAt(a, time), pointsAt(b, time)
+        check(len(pa) == len(pb), "same number of points (%d, %d)" % (len(pa), len(pb)))
+        p0 = pointsAt(a, "constant")
+        size = max(max(p[d] for p in p0) - min(p[d] for p in p0) for d in range(3))
+        diff = max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
+        check(diff <= tol*size, "largest difference %.3e <= %.1e x domain size %.3g" % (diff, tol, size))
+    elif mode == "at":
+        case, time = sys.argv[2:4]
+        x0, x1 = [float(v) for v in sys.argv[4:7]], [float(v) for v in sys.argv[7:10]]
+        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
+        i = min(range(len(p0)), key=lambda k: sum((p0[k][d] - x0[d])**2 for d in range(3)))
+        check(max(abs(p0[i][d] - x0[d]) for d in range(3)) < 1e-9, "a point at %s" % x0)
+        err = max(abs(p1[i][d] - x1[d]) for d in range(3))
+        check(err <= tol, "it moved to (%.12g %.12g %.12g), expected %s: error %.2e" % (p1[i] + (x1, err)))
+    else:
+        case, time = sys.argv[2:4]
+        twoD = "--2d" in sys.argv
+        p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
+        t = float(time)
+        move = [0.06*t/3, 0.03*t/3, 0.0 if twoD else 0.015*t/3]
+        hole = cube = slipErr = fixedErr = holeErr = zErr = 0.0
+        nHole = nSlip = nFixed = 0
+        for a, b in zip(p0, p1):
+            d = [b[k] - a[k] for k in range(3)]
+            inf = max(abs(a[0] - 0.5), abs(a[1] - 0.5))
+            if not twoD:
+                inf = max(inf, abs(a[2] - 0.5))
+            if abs(inf - 0.15) < 1e-12:
+                nHole += 1
+                holeErr = max(holeErr, max(abs(d[k] - move[k]) for k in range(3)))
+            if twoD:
+                zErr = max(zErr, abs(d[2]))
+                for k in (0,):   # x faces fixed in 2D
+                    if a[k] in (0.0, 1.0):
+                        nFixed += 1; fixedErr = max(fixedErr, max(abs(v) for v in d))
+                if a[1] in (0.0, 1.0):
+                    nSlip += 1; slipErr = max(slipErr, abs(d[1]))
+            else:
+                if a[2] in (0.0, 1.0):
                     nFixed += 1; fixedErr = max(fixedErr, max(abs(v) for v in d))
-            if a[1] in (0.0, 1.0):
-                nSlip += 1; slipErr = max(slipErr, abs(d[1]))
-        else:
-            if a[2] in (0.0, 1.0):
-                nFixed += 1; fixedErr = max(fixedErr, max(abs(v) for v in d))
-            for k in (0, 1):
-                if a[k] in (0.0, 1.0):
-                    nSlip += 1; slipErr = max(slipErr, abs(d[k]))
-    check(nHole > 0, "%d hole points found" % nHole)
-    check(holeErr <= 1e-12, "hole points follow the prescribed displacement: error %.3e" % holeErr)
-    check(nSlip > 0 and slipErr <= 1e-12, "%d slip points stay on their planes: %.3e" % (nSlip, slipErr))
-    check(nFixed > 0 and fixedErr <= 1e-12, "%d fixed points stay: %.3e" % (nFixed, fixedErr))
-    if twoD:
-        check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)
-    # the interior moved: the morph is not the identity
-    moved = max(max(abs(b[k] - a[k]) for k in range(3)) for a, b in zip(p0, p1))
-    check(moved > 0.01, "the mesh moved (largest displacement %.3g)" % moved)
-sys.exit(1 if failures else 0)
+                for k in (0, 1):
+                    if a[k] in (0.0, 1.0):
+                        nSlip += 1; slipErr = max(slipErr, abs(d[k]))
+        check(nHole > 0, "%d hole points found" % nHole)
+        check(holeErr <= 1e-12, "hole points follow the prescribed displacement: error %.3e" % holeErr)
+        check(nSlip > 0 and slipErr <= 1e-12, "%d slip points stay on their planes: %.3e" % (nSlip, slipErr))
+        check(nFixed > 0 and fixedErr <= 1e-12, "%d fixed points stay: %.3e" % (nFixed, fixedErr))
+        if twoD:
+            check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)
+        # the interior moved: the morph is not the identity
+        moved = max(max(abs(b[k] - a[k]) for k in range(3)) for a, b in zip(p0, p1))
+        check(moved > 0.01, "the mesh moved (largest displacement %.3g)" % moved)
+    return 1 if failures else 0
+
+if __name__ == "__main__":
+    sys.exit(main())
