@@ -190,11 +190,10 @@ template <int D> int run(const options& o)
     const double mem0 = peakMB();
     runSimulated(o.ranks, [&](const communicator& comm) {
         std::vector<point<D>> c, e;
-        for (const auto& x : ctrl) if (slab(x) == comm.rank()) c.push_back(x);
-        for (const auto& x : ev) if (slab(x) == comm.rank()) e.push_back(x);
         std::vector<double> v1, v2;
         for (std::size_t i = 0; i < ctrl.size(); ++i)
-            if (slab(ctrl[i]) == comm.rank()) { v1.push_back(pb.v1[i]); v2.push_back(pb.v2[i]); }
+            if (slab(ctrl[i]) == comm.rank()) { c.push_back(ctrl[i]); v1.push_back(pb.v1[i]); v2.push_back(pb.v2[i]); }
+        for (const auto& x : ev) if (slab(x) == comm.rank()) e.push_back(x);
 
         double t = seconds();
         std::unique_ptr<multilevel<D>> mba(new multilevel<D>(comm, prm, 1, c, {}, e));

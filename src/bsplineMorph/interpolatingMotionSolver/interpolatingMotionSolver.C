@@ -131,6 +131,25 @@ const double* Foam::interpolatingMotionSolver::evalCoordinates() const
 }
 
 
+void Foam::interpolatingMotionSolver::use
+(
+    const label slot,
+    std::unique_ptr<boundaryConstraints> set
+)
+{
+    std::unique_ptr<boundaryConstraints>& current =
+        slot == 0 ? constraintsPtr_ : refitPtr_;
+    const bool changed = !current || !set->sameControls(*current);
+    current = std::move(set);
+    slot_ = slot;
+    if (returnReduce(changed, orOp<bool>()) || !planned_[slot])
+    {
+        buildPlan();
+        planned_[slot] = true;
+    }
+}
+
+
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::interpolatingMotionSolver::interpolatingMotionSolver
@@ -206,14 +225,7 @@ void Foam::interpolatingMotionSolver::solve()
     }
     else
     {
-        const bool changed =
-            !constraintsPtr_ || !bc->sameControls(*constraintsPtr_);
-        constraintsPtr_ = std::move(bc);
-        if (returnReduce(changed, orOp<bool>()) || !planned_[0])
-        {
-            buildPlan();
-            planned_[0] = true;
-        }
+        use(0, std::move(bc));
         summary = interpolate(displacement);
 
         // Sliding planes not along the axes: project, then fit again with
@@ -222,19 +234,14 @@ void Foam::interpolatingMotionSolver::solve()
         if (constraintsPtr_->nProjectedGlobal() > 0)
         {
             constraintsPtr_->constrain(displacement);
-            std::unique_ptr<boundaryConstraints> refit
+            use
             (
-                new boundaryConstraints(*constraintsPtr_, displacement)
+                1,
+                std::unique_ptr<boundaryConstraints>
+                (
+                    new boundaryConstraints(*constraintsPtr_, displacement)
+                )
             );
-            const bool refitChanged =
-                !refitPtr_ || !refit->sameControls(*refitPtr_);
-            refitPtr_ = std::move(refit);
-            slot_ = 1;
-            if (returnReduce(refitChanged, orOp<bool>()) || !planned_[1])
-            {
-                buildPlan();
-                planned_[1] = true;
-            }
             summary += "; re-fit with the projected sliding points: " + interpolate(displacement);
             slot_ = 0;
         }
