@@ -5,11 +5,13 @@ namespace mba {
 /// non-negative, summing to one
 inline void cubicBasis(double s, double w[4])
 {
+    // times 1/6 rather than divided by 6: the evaluation's hottest few flops
+    constexpr double sixth = 1.0/6.0;
     const double t = 1.0 - s, s2 = s*s, s3 = s2*s;
-    w[0] = t*t*t/6.0;
-    w[1] = (3.0*s3 - 6.0*s2 + 4.0)/6.0;
-    w[2] = (-3.0*s3 + 3.0*s2 + 3.0*s + 1.0)/6.0;
-    w[3] = s3/6.0;
+    w[0] = t*t*t*sixth;
+    w[1] = (3.0*s3 - 6.0*s2 + 4.0)*sixth;
+    w[2] = (-3.0*s3 + 3.0*s2 + 3.0*s + 1.0)*sixth;
+    w[3] = s3*sixth;
 }
 }
 #endif

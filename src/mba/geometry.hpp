@@ -57,6 +57,21 @@ template <int D> struct indexBox
     }
 };
 
+/// Calls f(i) for every index of the box, the last direction fastest
+template <int D, class F>
+void forEachIndex(const indexBox<D>& b, F&& f)
+{
+    index<D> i = b.lo;
+    for (;;)
+    {
+        f(static_cast<const index<D>&>(i));
+        int d = D - 1;
+        while (d >= 0 && i[d] == b.hi[d]) { i[d] = b.lo[d]; --d; }
+        if (d < 0) break;
+        ++i[d];
+    }
+}
+
 /// Bounding box in space
 template <int D> struct box
 {

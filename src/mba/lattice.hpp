@@ -147,47 +147,54 @@ template <int D> struct stencil
     }
 };
 
+/// Ids of the (up to 2^D) tiles a stencil touches, -1 where absent: entry
+/// (i*2 + j)*2 + k holds tile (t0 + i, t0 + j, t0 + k), t0 = the stencil's first tile
+template <int D> using stencilTiles = std::array<std::int32_t, 1 << D>;
+
+/// Looks up the tiles of a stencil; returns whether any exists
+template <int D>
+bool findTiles(const tileLayout<D>& L, const stencil<D>& st, stencilTiles<D>& tid)
+{
+    const indexBox<D> b = st.tiles();
+    bool any = false;
+    for (int c = 0; c < (1 << D); ++c)
+    {
+        index<D> t;
+        bool in = true;
+        for (int d = 0; d < D; ++d)
+        {
+            t[d] = b.lo[d] + ((c >> (D - 1 - d)) & 1);
+            in = in && t[d] <= b.hi[d];
+        }
+        const std::int64_t id = in ? L.find(t) : -1;
+        tid[c] = std::int32_t(id);
+        any = any || id >= 0;
+    }
+    return any;
+}
+
 namespace detail {
 // Per direction: which of the (up to 2) touched tiles holds stencil node a, and where
 struct split1
 {
-    std::int64_t t0;
-    int nt, ta[4], oa[4];
+    int ta[4], oa[4];
     explicit split1(std::int64_t base)
     {
-        t0 = base/tileEdge;
+        const std::int64_t t0 = base/tileEdge;
         for (int a = 0; a < 4; ++a)
         {
             const std::int64_t n = base + a;
             ta[a] = int(n/tileEdge - t0);
             oa[a] = int(n - (n/tileEdge)*tileEdge);
         }
-        nt = ta[3] + 1;
-        r[0] = 0;
-        for (int a = 1; a < 4; ++a) if (ta[a] != ta[a - 1]) r[ta[a]] = a;
-        r[nt] = 4;
     }
-    int r[4];   ///< stencil positions [r[i], r[i+1]) lie in tile t0 + i
 };
 
-template <int NC>
-bool evalStencil(const tileLayout<3>& L, const double* phi, const stencil<3>& st, double* out)
+/// Visits the stencil's nodes in existing tiles: f(tileId, nodeInTile, weight)
+template <class F>
+inline __attribute__((always_inline)) void visitStencil(const stencilTiles<3>& tid, const stencil<3>& st, F&& f)
 {
-    constexpr int npt = tileLayout<3>::nodesPerTile;
     const split1 x(st.base[0]), y(st.base[1]), z(st.base[2]);
-    // The (up to 8) tiles first, then one regular 4 x 4 x 4 sweep
-    std::int64_t tid[8];
-    bool any = false;
-    for (int i = 0; i < x.nt; ++i)
-        for (int j = 0; j < y.nt; ++j)
-            for (int k = 0; k < z.nt; ++k)
-            {
-                const std::int64_t id = L.find(index<3>{{x.t0 + i, y.t0 + j, z.t0 + k}});
-                tid[(i*2 + j)*2 + k] = id;
-                any = any || id >= 0;
-            }
-    if (!any) return false;
-    double acc[NC] = {};
     for (int a = 0; a < 4; ++a)
     {
         const int ia = x.ta[a]*2, oa = x.oa[a]*tileEdge;
@@ -198,133 +205,82 @@ bool evalStencil(const tileLayout<3>& L, const double* phi, const stencil<3>& st
             const double wab = wa*st.w[1][b];
             for (int c = 0; c < 4; ++c)
             {
-                const std::int64_t id = tid[iab + z.ta[c]];
-                if (id < 0) continue;
-                const double w = wab*st.w[2][c];
-                const double* p = phi + (id*npt + oab + z.oa[c])*NC;
-                for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
+                const std::int32_t id = tid[iab + z.ta[c]];
+                if (id >= 0) f(std::int64_t(id), oab + z.oa[c], wab*st.w[2][c]);
             }
         }
     }
-    for (int v = 0; v < NC; ++v) out[v] += acc[v];
-    return true;
 }
 
-template <int NC>
-bool evalStencil(const tileLayout<2>& L, const double* phi, const stencil<2>& st, double* out)
+template <class F>
+inline __attribute__((always_inline)) void visitStencil(const stencilTiles<2>& tid, const stencil<2>& st, F&& f)
 {
-    constexpr int npt = tileLayout<2>::nodesPerTile;
     const split1 x(st.base[0]), y(st.base[1]);
-    double acc[NC] = {};
-    bool any = false;
-    for (int i = 0; i < x.nt; ++i)
-        for (int j = 0; j < y.nt; ++j)
+    for (int a = 0; a < 4; ++a)
+    {
+        const int ia = x.ta[a]*2, oa = x.oa[a]*tileEdge;
+        for (int b = 0; b < 4; ++b)
         {
-            const std::int64_t id = L.find(index<2>{{x.t0 + i, y.t0 + j}});
-            if (id < 0) continue;
-            any = true;
-            const double* T = phi + id*npt*NC;
-            for (int a = x.r[i]; a < x.r[i + 1]; ++a)
-            {
-                const double* row = T + x.oa[a]*tileEdge*NC;
-                for (int b = y.r[j]; b < y.r[j + 1]; ++b)
-                {
-                    const double w = st.w[0][a]*st.w[1][b];
-                    const double* p = row + y.oa[b]*NC;
-                    for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
-                }
-            }
+            const std::int32_t id = tid[ia + y.ta[b]];
+            if (id >= 0) f(std::int64_t(id), oa + y.oa[b], st.w[0][a]*st.w[1][b]);
         }
+    }
+}
+
+/// The value at a stencil (NC values per node). visitStencil is inlined here:
+/// out of line, the accumulators behind its reference cost 20% of the sweep.
+template <int D, int NC>
+void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile;
+    double acc[NC] = {};
+    visitStencil(tid, st, [phi, &acc](std::int64_t id, int n, double w) {
+        const double* p = phi + (id*npt + n)*NC;
+        for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
+    });
     for (int v = 0; v < NC; ++v) out[v] += acc[v];
-    return any;
 }
 } // namespace detail
 
-/// Adds the lattice's value at a stencil (nc components per node) to out[0..nc).
-/// Returns whether any of the stencil's tiles exists.
+/// Adds the lattice's value at a stencil whose tiles were looked up (nc
+/// components per node) to out[0..nc)
 template <int D>
-bool evalStencil(const tileLayout<D>& L, const double* phi, int nc, const stencil<D>& st, double* out)
+void evalStencil(const double* phi, int nc, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
 {
     switch (nc)
     {
-        case 1: return detail::evalStencil<1>(L, phi, st, out);
-        case 2: return detail::evalStencil<2>(L, phi, st, out);
-        default: return detail::evalStencil<3>(L, phi, st, out);
+        case 1: detail::sweepStencil<D, 1>(phi, tid, st, out); break;
+        case 2: detail::sweepStencil<D, 2>(phi, tid, st, out); break;
+        default: detail::sweepStencil<D, 3>(phi, tid, st, out);
     }
+}
+
+/// Adds the lattice's value at a stencil to out[0..nc). Returns whether any of
+/// the stencil's tiles exists.
+template <int D>
+bool evalStencil(const tileLayout<D>& L, const double* phi, int nc, const stencil<D>& st, double* out)
+{
+    stencilTiles<D> tid;
+    if (!findTiles(L, st, tid)) return false;
+    evalStencil(phi, nc, tid, st, out);
+    return true;
 }
 
 /// Create the tiles a stencil touches
 template <int D>
 void insertStencil(tileLayout<D>& L, const stencil<D>& st)
 {
-    const indexBox<D> b = st.tiles();
-    index<D> t = b.lo;
-    for (;;)
-    {
-        L.findOrInsert(t);
-        int d = D - 1;
-        while (d >= 0 && t[d] == b.hi[d]) { t[d] = b.lo[d]; --d; }
-        if (d < 0) break;
-        ++t[d];
-    }
+    forEachIndex<D>(st.tiles(), [&](const index<D>& t) { L.findOrInsert(t); });
 }
 
 /// Visit the stencil nodes that exist in the layout: f(tileId, nodeInTile, weight).
 /// Returns whether any tile existed.
-template <class F>
-bool forStencil(const tileLayout<3>& L, const stencil<3>& st, F&& f)
+template <int D, class F>
+bool forStencil(const tileLayout<D>& L, const stencil<D>& st, F&& f)
 {
-    const detail::split1 x(st.base[0]), y(st.base[1]), z(st.base[2]);
-    std::int64_t tid[3][3][3];
-    bool any = false;
-    for (int i = 0; i < x.nt; ++i)
-        for (int j = 0; j < y.nt; ++j)
-            for (int k = 0; k < z.nt; ++k)
-            {
-                const index<3> t{{x.t0 + i, y.t0 + j, z.t0 + k}};
-                const std::int64_t id = L.find(t);
-                tid[i][j][k] = id;
-                any = any || id >= 0;
-            }
-    if (!any) return false;
-    for (int a = 0; a < 4; ++a)
-    {
-        const double wa = st.w[0][a];
-        for (int b = 0; b < 4; ++b)
-        {
-            const double wab = wa*st.w[1][b];
-            const int nab = (x.oa[a]*tileEdge + y.oa[b])*tileEdge;
-            for (int c = 0; c < 4; ++c)
-            {
-                const std::int64_t id = tid[x.ta[a]][y.ta[b]][z.ta[c]];
-                if (id >= 0) f(id, nab + z.oa[c], wab*st.w[2][c]);
-            }
-        }
-    }
-    return true;
-}
-
-template <class F>
-bool forStencil(const tileLayout<2>& L, const stencil<2>& st, F&& f)
-{
-    const detail::split1 x(st.base[0]), y(st.base[1]);
-    std::int64_t tid[3][3];
-    bool any = false;
-    for (int i = 0; i < x.nt; ++i)
-        for (int j = 0; j < y.nt; ++j)
-        {
-            const index<2> t{{x.t0 + i, y.t0 + j}};
-            const std::int64_t id = L.find(t);
-            tid[i][j] = id;
-            any = any || id >= 0;
-        }
-    if (!any) return false;
-    for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b)
-        {
-            const std::int64_t id = tid[x.ta[a]][y.ta[b]];
-            if (id >= 0) f(id, x.oa[a]*tileEdge + y.oa[b], st.w[0][a]*st.w[1][b]);
-        }
+    stencilTiles<D> tid;
+    if (!findTiles(L, st, tid)) return false;
+    detail::visitStencil(tid, st, f);
     return true;
 }
 

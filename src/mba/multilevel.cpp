@@ -54,9 +54,22 @@ struct multilevel<D>::level
     double scale = 1;               ///< 2^k: u_k = u_0*scale
     tileLayout<D> own, view;
     bool ownIsView = false;         ///< serial, sparse: own tiles are the view (own left empty)
-    std::vector<double> phi, omega; ///< view data
+    std::vector<double> phi, invOmega; ///< view data: coefficients, 1/omega (0 where omega is)
     std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< own tile ids / view tile ids per rank
     std::vector<std::int64_t> ownToView; ///< empty when ownIsView
+    /// The tiles of the control points' stencils (in ctrlOrder_) in the view
+    /// and, in parallel, in the own layout
+    std::vector<stencilTiles<D>> ctrlView, ctrlOwn;
+    /// Ghosts: where a rank's control points near another rank's stencils cost
+    /// less to send than the tiles they touch (fine levels), the owner sends
+    /// their residuals and the receiver computes the owner's partial delta
+    /// from them, bitwise as the owner would (same points, same order).
+    /// ghostSend[r]: this rank's points whose residuals go to r (ghost mode to r);
+    /// ghostX[r]: r's ghost points, D coordinates + nc mask flags each;
+    /// ghostTiles[r]: their stencils' tiles, as positions in recvTiles[r]
+    std::vector<std::vector<std::uint32_t>> ghostSend;
+    std::vector<std::vector<double>> ghostX;
+    std::vector<std::vector<stencilTiles<D>>> ghostTiles;
     levelStats stats;
 
     const tileLayout<D>& ownTiles() const { return ownIsView ? view : own; }
@@ -161,6 +174,15 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
         "mba: at most 2^32 points per rank");
     ctrlOrder_ = spatialOrder<D>(ctrl_, dom_, &active_);
     evalOrder_ = spatialOrder<D>(eval_, dom_, nullptr);
+    evalLo0_.fill(HUGE_VAL);
+    evalHi0_.fill(-HUGE_VAL);
+    evalU0_.reserve(eval_.size);
+    for (const std::uint32_t i : evalOrder_)
+    {
+        const point<D> u = dom_.local0(eval_[i]);
+        evalU0_.push_back(u);
+        for (int d = 0; d < D; ++d) { evalLo0_[d] = std::min(evalLo0_[d], u[d]); evalHi0_[d] = std::max(evalHi0_[d], u[d]); }
+    }
 
     if (p_.affine)
     {
@@ -316,10 +338,7 @@ void multilevel<D>::buildLevel(int k)
             for (const double* x : queryGroups_[g])
             {
                 const point<D> u = scaled<D>(dom_.local0(x), L.scale);
-                const indexBox<D> tb = stencil<D>(u.data()).tiles();
-                index<D> t = tb.lo;
-                for (;;)
-                {
+                forEachIndex<D>(stencil<D>(u.data()).tiles(), [&](const index<D>& t) {
                     for (const std::size_t b : hits)
                     {
                         if (!remote[b].contains(t)) continue;
@@ -329,11 +348,7 @@ void multilevel<D>::buildLevel(int k)
                         requested[r].insert(key, 0);
                         if (requested[r].size() != before) requests[r].push_back(key);
                     }
-                    int d = D - 1;
-                    while (d >= 0 && t[d] == tb.hi[d]) { t[d] = tb.lo[d]; --d; }
-                    if (d < 0) break;
-                    ++t[d];
-                }
+                });
             }
         }
         const auto wanted = comm_.exchange(requests);
@@ -352,6 +367,33 @@ void multilevel<D>::buildLevel(int k)
         }
         keysGot = comm_.exchange(keys);
         omegaGot = comm_.exchange(om);
+
+        // Ghost mode towards r when this rank's points that touch the tiles r
+        // asked for cost less per apply (nc values each) than the tiles (npt*nc)
+        L.ghostSend.assign(P, {});
+        std::vector<std::vector<double>> gx(P);
+        std::vector<std::uint8_t> asked(nOwn);
+        for (int r = 0; r < P; ++r)
+        {
+            if (L.sendTiles[r].empty()) continue;
+            std::fill(asked.begin(), asked.end(), 0);
+            for (const std::int64_t id : L.sendTiles[r]) asked[id] = 1;
+            std::vector<std::uint32_t> g;
+            stencilTiles<D> tid;
+            forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+                findTiles(L.own, st, tid);
+                for (const std::int32_t id : tid)
+                    if (id >= 0 && asked[id]) { g.push_back(std::uint32_t(i)); break; }
+            });
+            if (g.size() >= std::size_t(npt)*L.sendTiles[r].size()) continue;
+            for (const std::uint32_t i : g)
+            {
+                gx[r].insert(gx[r].end(), ctrl_[i], ctrl_[i] + D);
+                for (int c = 0; c < nc_; ++c) gx[r].push_back(mask_.empty() || mask_[i*nc_ + c] ? 1.0 : 0.0);
+            }
+            L.ghostSend[r] = std::move(g);
+        }
+        L.ghostX = comm_.exchange(gx);
     }
 
     // The view: own and received tiles, dense when that is not much larger
@@ -366,7 +408,7 @@ void multilevel<D>::buildLevel(int k)
         L.view = std::move(L.own);
         L.own = tileLayout<D>();
         L.ownIsView = true;
-        L.omega = std::move(ownW);
+        L.invOmega = std::move(ownW);
     }
     else
     {
@@ -377,23 +419,50 @@ void multilevel<D>::buildLevel(int k)
             for (auto key : keysGot[r]) L.recvTiles[r].push_back(L.view.findOrInsertKey(key));
 
         // omega: partial sums added in rank order
-        L.omega.assign(L.view.size()*npt*nw_, 0.0);
+        L.invOmega.assign(L.view.size()*npt*nw_, 0.0);
         for (int r = 0; r < P; ++r)
         {
             if (r == me)
             {
                 for (std::int64_t id = 0; id < nOwn; ++id)
-                    for (int j = 0; j < npt*nw_; ++j) L.omega[L.ownToView[id]*npt*nw_ + j] += ownW[id*npt*nw_ + j];
+                    for (int j = 0; j < npt*nw_; ++j) L.invOmega[L.ownToView[id]*npt*nw_ + j] += ownW[id*npt*nw_ + j];
             }
             else
             {
                 const auto& og = omegaGot[r];
                 for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t)
-                    for (int j = 0; j < npt*nw_; ++j) L.omega[L.recvTiles[r][t]*npt*nw_ + j] += og[t*npt*nw_ + j];
+                    for (int j = 0; j < npt*nw_; ++j) L.invOmega[L.recvTiles[r][t]*npt*nw_ + j] += og[t*npt*nw_ + j];
             }
         }
     }
+    for (double& o : L.invOmega) o = o > 0 ? 1/o : 0.0;
+
+    // The ghosts' stencil tiles, numbered as the tiles received from their rank
+    L.ghostTiles.assign(P, {});
+    for (int r = 0; r < P && P > 1; ++r)
+    {
+        if (L.ghostX[r].empty()) continue;
+        std::vector<std::int32_t> at(L.view.size(), -1);
+        for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t) at[L.recvTiles[r][t]] = std::int32_t(t);
+        const std::size_t stride = D + nc_, ng = L.ghostX[r].size()/stride;
+        L.ghostTiles[r].resize(ng);
+        for (std::size_t g = 0; g < ng; ++g)
+        {
+            stencilTiles<D>& tid = L.ghostTiles[r][g];
+            findTiles(L.view, stencil<D>(scaled<D>(dom_.local0(&L.ghostX[r][g*stride]), L.scale).data()), tid);
+            for (std::int32_t& id : tid) if (id >= 0) id = at[id];
+        }
+    }
     L.phi.assign(L.view.size()*npt*nc_, 0.0);
+    precondition(L.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
+    L.ctrlView.resize(ctrlOrder_.size());
+    L.ctrlOwn.resize(P > 1 ? ctrlOrder_.size() : 0);
+    std::size_t pos = 0;
+    forOwnStencils(L, [&](std::size_t, const stencil<D>& st) {
+        findTiles(L.view, st, L.ctrlView[pos]);
+        if (P > 1) findTiles(L.own, st, L.ctrlOwn[pos]);
+        ++pos;
+    });
 
     levelStats& s = L.stats;
     s.level = k;
@@ -402,17 +471,26 @@ void multilevel<D>::buildLevel(int k)
     s.viewTiles = L.view.size();
     s.dense = L.view.dense();
     s.nodes = L.view.size()*npt;
-    s.bytes = std::int64_t((L.phi.capacity() + L.omega.capacity())*sizeof(double)
-        + L.own.bytes() + L.view.bytes() + L.ownToView.capacity()*sizeof(std::int64_t));
-    for (int r = 0; r < P; ++r)
+    s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
+        + L.own.bytes() + L.view.bytes() + L.ownToView.capacity()*sizeof(std::int64_t)
+        + (L.ctrlView.capacity() + L.ctrlOwn.capacity())*sizeof(stencilTiles<D>));
+    for (int r = 0; r < P && P > 1; ++r)
     {
         s.tilesSent += std::int64_t(L.sendTiles[r].size());
         s.tilesReceived += std::int64_t(L.recvTiles[r].size());
         s.messagesSent += !L.sendTiles[r].empty();
         s.messagesReceived += !L.recvTiles[r].empty();
+        s.ghostsSent += std::int64_t(L.ghostSend[r].size());
+        s.ghostsReceived += std::int64_t(L.ghostTiles[r].size());
+        const std::int64_t vs = L.ghostSend[r].empty() ? std::int64_t(L.sendTiles[r].size())*npt*nc_
+            : std::int64_t(L.ghostSend[r].size())*nc_;
+        const std::int64_t vr = L.ghostTiles[r].empty() ? std::int64_t(L.recvTiles[r].size())*npt*nc_
+            : std::int64_t(L.ghostTiles[r].size())*nc_;
+        s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
+        s.bytesReceivedPerApply += vr*std::int64_t(sizeof(double));
+        s.bytes += std::int64_t(L.ghostX[r].capacity()*sizeof(double)
+            + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>));
     }
-    s.bytesSentPerApply = s.tilesSent*npt*nc_*std::int64_t(sizeof(double));
-    s.bytesReceivedPerApply = s.tilesReceived*npt*nc_*std::int64_t(sizeof(double));
     s.planSeconds = now() - t0;
     levels_.push_back(std::move(Lp));
 }
@@ -439,28 +517,60 @@ void multilevel<D>::applyLevel(level& L)
     }
 
     // delta += w^2 phi_c = w^3 r_c / sum(w^2)
+    const std::vector<stencilTiles<D>>& tiles = direct ? L.ctrlView : L.ctrlOwn;
+    std::size_t pos = 0;
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
         const double sw = st.sumSquares();
         double rr[3];
         for (int c = 0; c < nc_; ++c)
             rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        forStencil(L.ownTiles(), st, [&](std::int64_t id, int n, double w) {
+        // rr by value: the stores through dl cannot alias it
+        detail::visitStencil(tiles[pos++], st, [delta, rr, nc = nc_](std::int64_t id, int n, double w) {
             const double w3 = w*w*w;
-            double* dl = delta + ((direct ? L.toView(id) : id)*npt + n)*nc_;
-            for (int c = 0; c < nc_; ++c) dl[c] += w3*rr[c];
+            double* dl = delta + (id*npt + n)*nc;
+            for (int c = 0; c < nc; ++c) dl[c] += w3*rr[c];
         });
     });
 
     if (!direct)
     {
-        // Exchange the partial delta of the requested tiles
+        // Exchange the partial delta of the requested tiles, or the residuals
+        // of the ghosts
         std::vector<std::vector<double>> send(P);
         for (int r = 0; r < P; ++r)
         {
+            if (!L.ghostSend[r].empty())
+            {
+                for (const std::uint32_t i : L.ghostSend[r])
+                    send[r].insert(send[r].end(), &residual_[i*nc_], &residual_[i*nc_] + nc_);
+                continue;
+            }
             send[r].reserve(L.sendTiles[r].size()*blk);
             for (auto id : L.sendTiles[r]) send[r].insert(send[r].end(), delta + id*blk, delta + (id + 1)*blk);
         }
-        const std::vector<std::vector<double>> got = comm_.exchange(send);
+        std::vector<std::vector<double>> got = comm_.exchange(send);
+
+        // The ghosts' rank's partial delta, as it computes it
+        const std::size_t stride = D + nc_;
+        for (int r = 0; r < P; ++r)
+        {
+            if (L.ghostTiles[r].empty()) continue;
+            std::vector<double> dl(L.recvTiles[r].size()*blk, 0.0);
+            for (std::size_t g = 0; g < L.ghostTiles[r].size(); ++g)
+            {
+                const double* x = &L.ghostX[r][g*stride];
+                const stencil<D> st(scaled<D>(dom_.local0(x), L.scale).data());
+                const double sw = st.sumSquares();
+                double rr[3];
+                for (int c = 0; c < nc_; ++c) rr[c] = x[D + c] != 0 ? got[r][g*nc_ + c]/sw : 0.0;
+                detail::visitStencil(L.ghostTiles[r][g], st, [&dl, rr, nc = nc_](std::int64_t id, int n, double w) {
+                    const double w3 = w*w*w;
+                    double* d = &dl[(id*npt + n)*nc];
+                    for (int c = 0; c < nc; ++c) d[c] += w3*rr[c];
+                });
+            }
+            got[r].swap(dl);
+        }
 
         // sum over ranks, in rank order
         for (int r = 0; r < P; ++r)
@@ -485,18 +595,23 @@ void multilevel<D>::applyLevel(level& L)
             }
         }
     }
-    const std::size_t nNodes = L.phi.size()/nc_;
-    for (std::size_t n = 0; n < nNodes; ++n)
-        for (int c = 0; c < nc_; ++c)
-        {
-            const double o = L.omega[n*nw_ + (nw_ == 1 ? 0 : c)];
-            L.phi[n*nc_ + c] = o > 0 ? L.phi[n*nc_ + c]/o : 0.0;
-        }
+    // phi = delta/omega (no contribution where omega is 0: delta is 0 there too)
+    if (nw_ == 1)
+    {
+        const std::size_t nNodes = L.invOmega.size();
+        for (std::size_t n = 0; n < nNodes; ++n)
+            for (int c = 0; c < nc_; ++c) L.phi[n*nc_ + c] *= L.invOmega[n];
+    }
+    else
+    {
+        for (std::size_t j = 0; j < L.phi.size(); ++j) L.phi[j] *= L.invOmega[j];
+    }
 
     // Residuals at this rank's control points
+    pos = 0;
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
         double acc[3] = {0, 0, 0};
-        evalStencil(L.view, L.phi.data(), nc_, st, acc);
+        evalStencil(L.phi.data(), nc_, L.ctrlView[pos++], st, acc);
         for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= acc[c];
     });
 }
@@ -580,83 +695,203 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
 
 namespace {
 
-/// Offset of node j in a dense tile layout with ntile tiles per direction
 template <int D>
-std::int64_t denseOffset(const index<D>& j, const index<D>& ntile)
+double boxNodes(const indexBox<D>& b)
 {
-    std::int64_t t = 0, n = 0;
-    for (int d = 0; d < D; ++d)
-    {
-        t = t*ntile[d] + j[d]/tileEdge;
-        n = n*tileEdge + j[d]%tileEdge;
-    }
-    return t*tileSize<D>::nodes + n;
+    double n = 1;
+    for (int d = 0; d < D; ++d) n *= double(b.hi[d] - b.lo[d] + 1);
+    return n;
 }
 
-/// Fine-level parents of fine node jf in one direction (uniform cubic B-spline
-/// subdivision): node 2j-1 = (P[j-1] + 6 P[j] + P[j+1])/8, node 2j = (P[j] + P[j+1])/2
-inline int parents(std::int64_t jf, std::int64_t jmax, std::int64_t* j, double* w)
+/// Coarse parents of fine node jf in one direction (uniform cubic B-spline
+/// subdivision; node j lies at lo + (j - 1) h): fine node 2j - 1 = (P[j-1] +
+/// 6 P[j] + P[j+1])/8, fine node 2j = (P[j] + P[j+1])/2. Parents outside
+/// [lo, hi] are left out.
+inline int parents(std::int64_t jf, std::int64_t lo, std::int64_t hi, std::int64_t* j, double* w)
 {
     int n = 0;
-    auto add = [&](std::int64_t i, double wt) { if (i >= 0 && i <= jmax) { j[n] = i; w[n] = wt; ++n; } };
+    auto add = [&](std::int64_t i, double wt) { if (i >= lo && i <= hi) { j[n] = i; w[n] = wt; ++n; } };
     if (jf % 2 == 0) { add(jf/2, 0.5); add(jf/2 + 1, 0.5); }
     else { const std::int64_t c = (jf + 1)/2; add(c - 1, 0.125); add(c, 0.75); add(c + 1, 0.125); }
     return n;
 }
 
+/// Values G (nc per node) on the node box cb of one level, refined to the next
+/// level on the node box fb, one direction at a time (the parents of fb's
+/// nodes that the stencils of points inside the boxes use lie in cb)
+template <int D>
+void refine(std::vector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, std::vector<double>& T)
+{
+    index<D> n;
+    for (int d = 0; d < D; ++d) n[d] = cb.hi[d] - cb.lo[d] + 1;
+    std::vector<std::int64_t> pj;
+    std::vector<double> pw;
+    std::vector<int> np;
+    for (int d = 0; d < D; ++d)
+    {
+        std::int64_t outer = 1, inner = nc;
+        for (int e = 0; e < d; ++e) outer *= n[e];
+        for (int e = d + 1; e < D; ++e) inner *= n[e];
+        const std::int64_t nf = fb.hi[d] - fb.lo[d] + 1, nco = n[d];
+        pj.assign(3*nf, 0);
+        pw.assign(3*nf, 0.0);
+        np.assign(nf, 0);
+        for (std::int64_t jf = 0; jf < nf; ++jf)
+        {
+            np[jf] = parents(fb.lo[d] + jf, cb.lo[d], cb.hi[d], &pj[3*jf], &pw[3*jf]);
+            for (int q = 0; q < np[jf]; ++q) pj[3*jf + q] -= cb.lo[d];
+        }
+        T.assign(std::size_t(outer*nf*inner), 0.0);
+        for (std::int64_t o = 0; o < outer; ++o)
+            for (std::int64_t jf = 0; jf < nf; ++jf)
+            {
+                double* t = &T[(o*nf + jf)*inner];
+                for (int q = 0; q < np[jf]; ++q)
+                {
+                    const double* g = &G[(o*nco + pj[3*jf + q])*inner];
+                    const double w = pw[3*jf + q];
+                    for (std::int64_t i = 0; i < inner; ++i) t[i] += w*g[i];
+                }
+            }
+        n[d] = nf;
+        G.swap(T);
+    }
+}
+
+/// Adds the value at a stencil of a plain lattice (nodes of box b, the last
+/// direction fastest, NC values per node): the 4 nodes along the last
+/// direction are contiguous, so the 4^(D-1) rows are summed first
+template <int NC>
+void flatStencil(const double* G, const indexBox<3>& b, const stencil<3>& st, double* out)
+{
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
+    const double* p0 = G + (((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*n2 + (st.base[2] - b.lo[2]))*NC;
+    double row[4*NC] = {};
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c)
+        {
+            const double w = st.w[0][a]*st.w[1][c];
+            const double* p = p0 + (a*n1 + c)*n2*NC;
+            for (int j = 0; j < 4*NC; ++j) row[j] += w*p[j];
+        }
+    for (int c = 0; c < 4; ++c)
+        for (int v = 0; v < NC; ++v) out[v] += st.w[2][c]*row[c*NC + v];
+}
+
+template <int NC>
+void flatStencil(const double* G, const indexBox<2>& b, const stencil<2>& st, double* out)
+{
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
+    const double* p0 = G + ((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*NC;
+    double row[4*NC] = {};
+    for (int a = 0; a < 4; ++a)
+    {
+        const double* p = p0 + a*n1*NC;
+        for (int j = 0; j < 4*NC; ++j) row[j] += st.w[0][a]*p[j];
+    }
+    for (int c = 0; c < 4; ++c)
+        for (int v = 0; v < NC; ++v) out[v] += st.w[1][c]*row[c*NC + v];
+}
+
+template <int D>
+void flatStencil(const double* G, const indexBox<D>& b, int nc, const stencil<D>& st, double* out)
+{
+    switch (nc)
+    {
+        case 1: flatStencil<1>(G, b, st, out); break;
+        case 2: flatStencil<2>(G, b, st, out); break;
+        default: flatStencil<3>(G, b, st, out);
+    }
+}
+
 } // namespace
+
+template <int D>
+indexBox<D> multilevel<D>::evalNodeBox(int k) const
+{
+    const double s = std::ldexp(1.0, k);
+    indexBox<D> b;
+    for (int d = 0; d < D; ++d)
+    {
+        b.lo[d] = std::int64_t(std::floor(evalLo0_[d]*s));
+        b.hi[d] = std::int64_t(std::floor(evalHi0_[d]*s)) + 3;
+    }
+    return b;
+}
 
 template <int D>
 void multilevel<D>::fold()
 {
-    folded_ = -1;
+    constexpr int npt = level::npt;
+    flat_ = -1;
+    flatPhi_.clear();
+    if (eval_.size == 0) return;
+    const double budget = double(std::max<std::size_t>(eval_.size, 4096));
     int m = -1;
-    while (m + 1 < report_.levels && levels_[m + 1]->view.dense()) ++m;
-    if (m < 1) return;
-    std::vector<double> F = levels_[0]->phi, G;
-    for (int k = 1; k <= m; ++k)
+    while (m + 1 < report_.levels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
+    if (m < 0) return;
+    std::vector<double> G, T;
+    indexBox<D> gb;
+    for (int k = 0; k <= m; ++k)
     {
-        index<D> nc, nf, tc, tf;
-        for (int d = 0; d < D; ++d)
+        const indexBox<D> fb = evalNodeBox(k);
+        if (k == 0) G.assign(std::size_t(boxNodes<D>(fb))*nc_, 0.0);
+        else refine<D>(G, gb, fb, nc_, T);
+        gb = fb;
+        // + this level's coefficients in the box
+        const level& L = *levels_[k];
+        index<D> n;
+        for (int d = 0; d < D; ++d) n[d] = gb.hi[d] - gb.lo[d] + 1;
+        for (std::int64_t id = 0; id < L.view.size(); ++id)
         {
-            nc[d] = dom_.nodes(k - 1, d);
-            nf[d] = dom_.nodes(k, d);
-            tc[d] = (nc[d] + tileEdge - 1)/tileEdge;
-            tf[d] = (nf[d] + tileEdge - 1)/tileEdge;
-        }
-        G = levels_[k]->phi;
-        index<D> jf{};
-        for (;;)
-        {
-            std::int64_t pj[D][3];
-            double pw[D][3];
-            int np[D];
-            for (int d = 0; d < D; ++d) np[d] = parents(jf[d], nc[d] - 1, pj[d], pw[d]);
-            double acc[3] = {0, 0, 0};
-            int a[D] = {};
-            for (;;)
+            const index<D> t = L.view.coord(L.view.keyOf(id));
+            indexBox<D> nb;
+            bool inside = true;
+            for (int d = 0; d < D; ++d)
             {
-                index<D> jc;
-                double w = 1;
-                for (int d = 0; d < D; ++d) { jc[d] = pj[d][a[d]]; w *= pw[d][a[d]]; }
-                const double* f = &F[denseOffset<D>(jc, tc)*nc_];
-                for (int c = 0; c < nc_; ++c) acc[c] += w*f[c];
-                int d = D - 1;
-                while (d >= 0 && a[d] == np[d] - 1) { a[d] = 0; --d; }
-                if (d < 0) break;
-                ++a[d];
+                nb.lo[d] = std::max(t[d]*tileEdge, gb.lo[d]);
+                nb.hi[d] = std::min(t[d]*tileEdge + tileEdge - 1, gb.hi[d]);
+                inside = inside && nb.lo[d] <= nb.hi[d];
             }
-            double* g = &G[denseOffset<D>(jf, tf)*nc_];
-            for (int c = 0; c < nc_; ++c) g[c] += acc[c];
-            int d = D - 1;
-            while (d >= 0 && jf[d] == nf[d] - 1) { jf[d] = 0; --d; }
-            if (d < 0) break;
-            ++jf[d];
+            if (!inside) continue;
+            forEachIndex<D>(nb, [&](const index<D>& j) {
+                std::int64_t g = 0, q = 0;
+                for (int d = 0; d < D; ++d)
+                {
+                    g = g*n[d] + (j[d] - gb.lo[d]);
+                    q = q*tileEdge + (j[d] - t[d]*tileEdge);
+                }
+                const double* p = &L.phi[(id*npt + q)*nc_];
+                double* o = &G[g*nc_];
+                for (int c = 0; c < nc_; ++c) o[c] += p[c];
+            });
         }
-        F.swap(G);
     }
-    foldedPhi_.swap(F);
-    folded_ = m;
+    flatPhi_.swap(G);
+    flatBox_ = gb;
+    flat_ = m;
+
+    // Which finer levels have tiles at each evaluation point (the same as
+    // long as the levels and flat_ are)
+    const std::pair<int, int> key(int(levels_.size()), flat_);
+    if (key == reachKey_) return;
+    reach_.assign(eval_.size, 0);
+    deepTiles_.clear();
+    stencilTiles<D> tid;
+    for (std::size_t q = 0; q < evalOrder_.size(); ++q)
+    {
+        const std::uint32_t i = evalOrder_[q];
+        const point<D>& u0 = evalU0_[q];
+        int k = flat_ + 1;
+        for (; k < int(levels_.size()); ++k)
+        {
+            if (!findTiles(levels_[k]->view, stencil<D>(scaled<D>(u0, levels_[k]->scale).data()), tid)) break;
+            deepTiles_.push_back(tid);
+        }
+        reach_[i] = std::uint8_t(k);
+    }
+    deepTiles_.shrink_to_fit();
+    reachKey_ = key;
 }
 
 template <int D>
@@ -664,14 +899,12 @@ void multilevel<D>::addLevels(const double* x, double* out, int nLevels) const
 {
     affine_.addTo(x, out);
     const point<D> u0 = dom_.local0(x);
-    for (int k = std::max(folded_, 0); k < nLevels; ++k)
+    for (int k = 0; k < nLevels; ++k)
     {
         const level& L = *levels_[k];
-        const point<D> u = scaled<D>(u0, L.scale);
-        const double* phi = k == folded_ ? foldedPhi_.data() : L.phi.data();
         // No stored tile here: none at finer levels either (their nodes lie
         // within the stencils of the same control points)
-        if (!evalStencil(L.view, phi, nc_, stencil<D>(u.data()), out)) break;
+        if (!evalStencil(L.view, L.phi.data(), nc_, stencil<D>(scaled<D>(u0, L.scale).data()), out)) break;
     }
 }
 
@@ -679,7 +912,31 @@ template <int D>
 void multilevel<D>::evaluate(std::vector<double>& out) const
 {
     out.assign(eval_.size*nc_, 0.0);
-    for (const std::uint32_t i : evalOrder_) addLevels(eval_[i], &out[i*nc_], report_.levels);
+    if (flat_ < 0)
+    {
+        for (const std::uint32_t i : evalOrder_) addLevels(eval_[i], &out[i*nc_], report_.levels);
+        return;
+    }
+    // The flat lattice, then the finer levels that have tiles at the point
+    // The affine part in the points' own order (reading them in sequence),
+    // then the lattices in evalOrder_
+    for (std::size_t i = 0; i < eval_.size; ++i) affine_.addTo(eval_[i], &out[i*nc_]);
+    const double sf = std::ldexp(1.0, flat_);
+    const stencilTiles<D>* deep = deepTiles_.data();
+    for (std::size_t q = 0; q < evalOrder_.size(); ++q)
+    {
+        const std::uint32_t i = evalOrder_[q];
+        const point<D>& u0 = evalU0_[q];
+        double* o = &out[i*nc_];
+        flatStencil<D>(flatPhi_.data(), flatBox_, nc_, stencil<D>(scaled<D>(u0, sf).data()), o);
+        const int top = std::min<int>(reach_[i], report_.levels);
+        for (int k = flat_ + 1; k < top; ++k)
+        {
+            const level& L = *levels_[k];
+            evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), o);
+        }
+        deep += std::max(0, reach_[i] - flat_ - 1);
+    }
 }
 
 template <int D>
@@ -709,9 +966,10 @@ std::vector<levelStats> multilevel<D>::stats() const
 template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
-    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + foldedPhi_.capacity())*sizeof(double)
-        + active_.capacity() + mask_.capacity()
-        + (ctrlOrder_.capacity() + evalOrder_.capacity())*sizeof(std::uint32_t));
+    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + flatPhi_.capacity())*sizeof(double)
+        + active_.capacity() + mask_.capacity() + reach_.capacity() + deepTiles_.capacity()*sizeof(stencilTiles<D>)
+        + (ctrlOrder_.capacity() + evalOrder_.capacity())*sizeof(std::uint32_t)
+        + evalU0_.capacity()*sizeof(point<D>));
     for (const auto& L : levels_) b += L->stats.bytes;
     return b;
 }

@@ -20,6 +20,10 @@
 // points (its control and evaluation points) for exactly the tiles those
 // stencils touch, receives their partial sums point to point and adds them in
 // rank order, so every rank that sees a node gets bitwise the same phi there.
+// At fine levels the owner's control points that touch the asked tiles are
+// fewer than the tiles' nodes: the owner then sends their coordinates once and
+// their residuals per fit ("ghosts"), and the asking rank computes the owner's
+// partial sums itself, with the same points in the same order (bitwise equal).
 #ifndef MBA_MULTILEVEL_HPP
 #define MBA_MULTILEVEL_HPP
 
@@ -68,6 +72,7 @@ struct levelStats
     std::int64_t bytes = 0;               ///< bytes of the level (view data, layouts)
     std::int64_t buckets = 0;             ///< this rank's buckets
     std::int64_t tilesSent = 0, tilesReceived = 0; ///< per apply, to / from other ranks
+    std::int64_t ghostsSent = 0, ghostsReceived = 0; ///< control points whose residuals are sent instead of tiles
     std::int64_t messagesSent = 0, messagesReceived = 0;
     std::int64_t bytesSentPerApply = 0, bytesReceivedPerApply = 0;
     double maxResidual = 0, rmsResidual = 0; ///< after this level (global)
@@ -104,12 +109,24 @@ class multilevel
     std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
     std::vector<std::vector<const double*>> queryGroups_; ///< the points of each cluster
     std::vector<std::uint32_t> ctrlOrder_, evalOrder_; ///< active control / evaluation points in space-filling-curve order
+    std::vector<point<D>> evalU0_;      ///< level-0 local coordinates of the evaluation points, in evalOrder_
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
-    /// Levels 0..folded_ (all dense) refined into one lattice at level folded_
-    /// (B-spline subdivision: exact), so evaluation costs one stencil for them
-    int folded_ = -1;
-    std::vector<double> foldedPhi_;
+    /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed into
+    /// one plain, untiled lattice over the level-flat_ nodes that the planned
+    /// evaluation points' stencils touch (flatBox_), so that most points cost
+    /// one contiguous stencil; flat_ is the finest level whose box has at most
+    /// as many nodes as there are evaluation points (-1: none)
+    int flat_ = -1;
+    point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
+    indexBox<D> flatBox_;
+    std::vector<double> flatPhi_;
+    /// Per evaluation point: the first level above flat_ whose lattice has no
+    /// tile at its stencil (none finer has one either), for reachKey_
+    std::vector<std::uint8_t> reach_;
+    /// Their tiles at levels flat_ + 1 .. reach - 1, point after point in evalOrder_
+    std::vector<stencilTiles<D>> deepTiles_;
+    std::pair<int, int> reachKey_{-1, -1}; ///< (levels built, flat_) reach_ was probed for
     fitReport report_;
     std::int64_t nCtrlGlobal_ = 0;
 
@@ -119,6 +136,7 @@ class multilevel
     void residualStats(double& maxr, double& rms) const;
     void addLevels(const double* x, double* out, int nLevels) const;
     void fold();
+    indexBox<D> evalNodeBox(int k) const;
 
 public:
     /// The plan. control, evaluation: this rank's points (not copied: they must

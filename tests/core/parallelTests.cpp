@@ -213,6 +213,49 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
     }
 }
 
+TEST_CASE("fine levels exchange ghost residuals, not tiles; coarse levels tiles", "[parallel]")
+{
+    // A surface (points on the cube's faces, the morphing case), slabs along x
+    const auto c = surfacePoints<3>(40);
+    const auto e = randomPoints<3>(8000, 111);
+    const auto v = smoothValues<3>(c, 3);
+    params p;
+    p.tolerance = 1e-8;
+    p.maxLevels = 9;
+    for (const int P : {2, 4, 8})
+    {
+        std::vector<std::vector<levelStats>> st(P);
+        runSimulated(P, [&](const communicator& comm) {
+            std::vector<point<3>> cl, el;
+            std::vector<double> vl;
+            for (std::size_t i = 0; i < c.size(); ++i)
+                if (std::min(P - 1, int(c[i][0]*P)) == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
+            for (const auto& x : e) if (std::min(P - 1, int(x[0]*P)) == comm.rank()) el.push_back(x);
+            multilevel<3> m(comm, p, 3, cl, {}, el);
+            m.fit(vl);
+            st[comm.rank()] = m.stats();
+        });
+        int finestReceivers = 0;
+        for (int r = 0; r < P; ++r)
+        {
+            INFO(P << " ranks, rank " << r);
+            const levelStats& coarse = st[r][0];
+            const levelStats& finest = st[r].back();
+            // level 0: one tile from each other rank, cheaper than any ghost set
+            CHECK(coarse.ghostsReceived == 0);
+            CHECK(coarse.tilesReceived == P - 1);
+            CHECK(coarse.bytesReceivedPerApply == (P - 1)*tileLayout<3>::nodesPerTile*3*std::int64_t(sizeof(double)));
+            // finest level: ghosts, each costing 3 values instead of a tile's 64 x 3
+            if (finest.tilesReceived == 0) continue;
+            ++finestReceivers;
+            REQUIRE(finest.ghostsReceived > 0);
+            CHECK(finest.bytesReceivedPerApply == finest.ghostsReceived*3*std::int64_t(sizeof(double)));
+            CHECK(finest.bytesReceivedPerApply*8 < finest.tilesReceived*tileLayout<3>::nodesPerTile*3*std::int64_t(sizeof(double)));
+        }
+        CHECK(finestReceivers >= P - 1);
+    }
+}
+
 TEST_CASE("bad input on one rank fails every rank with the same message", "[parallel][errors]")
 {
     const int P = 3;

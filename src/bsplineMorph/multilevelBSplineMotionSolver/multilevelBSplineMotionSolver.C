@@ -21,6 +21,8 @@ License
 #include "Enum.H"
 #include "clockTime.H"
 
+#include <chrono>
+
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
 namespace Foam
@@ -151,10 +153,13 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
     std::vector<double> out;
+    double evalSeconds = 0;
     try
     {
         plan.fit(bc.values());
+        const auto t0 = std::chrono::steady_clock::now();
         plan.evaluate(out);
+        evalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     catch (const std::exception& e)
     {
@@ -177,6 +182,13 @@ std::string Foam::multilevelBSplineMotionSolver::morph
         {
             nodes += s.nodes;
             bytes += s.bytesReceivedPerApply;
+            if (debug)
+            {
+                Pout<< type() << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
+                    << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
+                    << (s.dense ? " dense" : " sparse") << " received " << s.bytesReceivedPerApply
+                    << " B, max residual " << s.maxResidual << ", " << s.seconds << " s" << endl;
+            }
         }
     }
     nodes = returnReduce(nodes, sumOp<scalar>());
@@ -187,7 +199,8 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     os  << r.levels << " levels, max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
-        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank)";
+        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank), fit "
+        << r.seconds << " s, evaluation " << evalSeconds << " s";
     return os.str();
 }
 
