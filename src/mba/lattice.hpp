@@ -115,6 +115,8 @@ template <int D> struct stencil
     index<D> base;
     double w[D][4];
 
+    stencil() = default;
+
     /// From level-local coordinates u (cell floor(u), s = u - floor(u))
     explicit stencil(const double* u)
     {

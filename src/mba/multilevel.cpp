@@ -173,10 +173,26 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
     precondition(ctrl_.size < (std::size_t(1) << 32) && eval_.size < (std::size_t(1) << 32),
         "mba: at most 2^32 points per rank");
     ctrlOrder_ = spatialOrder<D>(ctrl_, dom_, &active_);
+    for (const std::uint32_t i : ctrlOrder_) ctrlU0_.push_back(dom_.local0(ctrl_[i]));
     evalOrder_ = spatialOrder<D>(eval_, dom_, nullptr);
+    {
+        // Mesh points mostly come numbered with locality already: when their
+        // own order is about as short a path as the curve's, it serves, and
+        // the results are then written in sequence
+        auto path = [&](auto at) {
+            double s = 0;
+            for (std::size_t q = 1; q < eval_.size; ++q)
+                for (int d = 0; d < D; ++d) s += std::abs(eval_[at(q)][d] - eval_[at(q - 1)][d]);
+            return s;
+        };
+        if (path([](std::size_t q) { return q; }) <= 1.5*path([&](std::size_t q) { return evalOrder_[q]; }))
+            for (std::size_t q = 0; q < eval_.size; ++q) evalOrder_[q] = std::uint32_t(q);
+    }
     evalLo0_.fill(HUGE_VAL);
     evalHi0_.fill(-HUGE_VAL);
     evalU0_.reserve(eval_.size);
+    evalPos_.resize(eval_.size);
+    for (std::size_t q = 0; q < evalOrder_.size(); ++q) evalPos_[evalOrder_[q]] = std::uint32_t(q);
     for (const std::uint32_t i : evalOrder_)
     {
         const point<D> u = dom_.local0(eval_[i]);
@@ -227,11 +243,8 @@ template <int D>
 template <class F>
 void multilevel<D>::forOwnStencils(const level& L, F&& f) const
 {
-    for (const std::uint32_t i : ctrlOrder_)
-    {
-        const point<D> u = scaled<D>(dom_.local0(ctrl_[i]), L.scale);
-        f(std::size_t(i), stencil<D>(u.data()));
-    }
+    for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+        f(std::size_t(ctrlOrder_[q]), stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data()));
 }
 
 template <int D>
@@ -519,7 +532,9 @@ void multilevel<D>::applyLevel(level& L)
     // delta += w^2 phi_c = w^3 r_c / sum(w^2)
     const std::vector<stencilTiles<D>>& tiles = direct ? L.ctrlView : L.ctrlOwn;
     std::size_t pos = 0;
+    stencils_.resize(ctrlOrder_.size());
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+        stencils_[pos] = st;    // again for the residuals below
         const double sw = st.sumSquares();
         double rr[3];
         for (int c = 0; c < nc_; ++c)
@@ -608,12 +623,13 @@ void multilevel<D>::applyLevel(level& L)
     }
 
     // Residuals at this rank's control points
-    pos = 0;
-    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+    for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+    {
+        const std::size_t i = ctrlOrder_[q];
         double acc[3] = {0, 0, 0};
-        evalStencil(L.phi.data(), nc_, L.ctrlView[pos++], st, acc);
+        evalStencil(L.phi.data(), nc_, L.ctrlView[q], stencils_[q], acc);
         for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= acc[c];
-    });
+    }
 }
 
 template <int D>
@@ -830,7 +846,9 @@ void multilevel<D>::fold()
     int m = -1;
     while (m + 1 < report_.levels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
     if (m < 0) return;
-    std::vector<double> G, T;
+    // flatPhi_ and foldScratch_ keep their storage from fit to fit
+    std::vector<double>& G = flatPhi_;
+    std::vector<double>& T = foldScratch_;
     indexBox<D> gb;
     for (int k = 0; k <= m; ++k)
     {
@@ -867,7 +885,6 @@ void multilevel<D>::fold()
             });
         }
     }
-    flatPhi_.swap(G);
     flatBox_ = gb;
     flat_ = m;
 
@@ -880,7 +897,6 @@ void multilevel<D>::fold()
     stencilTiles<D> tid;
     for (std::size_t q = 0; q < evalOrder_.size(); ++q)
     {
-        const std::uint32_t i = evalOrder_[q];
         const point<D>& u0 = evalU0_[q];
         int k = flat_ + 1;
         for (; k < int(levels_.size()); ++k)
@@ -888,7 +904,7 @@ void multilevel<D>::fold()
             if (!findTiles(levels_[k]->view, stencil<D>(scaled<D>(u0, levels_[k]->scale).data()), tid)) break;
             deepTiles_.push_back(tid);
         }
-        reach_[i] = std::uint8_t(k);
+        reach_[q] = std::uint8_t(k);
     }
     deepTiles_.shrink_to_fit();
     reachKey_ = key;
@@ -917,25 +933,33 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
         for (const std::uint32_t i : evalOrder_) addLevels(eval_[i], &out[i*nc_], report_.levels);
         return;
     }
-    // The flat lattice, then the finer levels that have tiles at the point
-    // The affine part in the points' own order (reading them in sequence),
-    // then the lattices in evalOrder_
-    for (std::size_t i = 0; i < eval_.size; ++i) affine_.addTo(eval_[i], &out[i*nc_]);
+    // The lattices in evalOrder_ (the flat one, then the finer levels that
+    // have tiles at the point) into sweep_, then, in the points' own order,
+    // the affine part plus the lattices' value: the reads and writes of the
+    // points and results are in sequence, only sweep_ is gathered
+    sweep_.resize(eval_.size*nc_);
     const double sf = std::ldexp(1.0, flat_);
     const stencilTiles<D>* deep = deepTiles_.data();
     for (std::size_t q = 0; q < evalOrder_.size(); ++q)
     {
-        const std::uint32_t i = evalOrder_[q];
         const point<D>& u0 = evalU0_[q];
-        double* o = &out[i*nc_];
-        flatStencil<D>(flatPhi_.data(), flatBox_, nc_, stencil<D>(scaled<D>(u0, sf).data()), o);
-        const int top = std::min<int>(reach_[i], report_.levels);
+        double acc[3] = {0, 0, 0};
+        flatStencil<D>(flatPhi_.data(), flatBox_, nc_, stencil<D>(scaled<D>(u0, sf).data()), acc);
+        const int top = std::min<int>(reach_[q], report_.levels);
         for (int k = flat_ + 1; k < top; ++k)
         {
             const level& L = *levels_[k];
-            evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), o);
+            evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), acc);
         }
-        deep += std::max(0, reach_[i] - flat_ - 1);
+        deep += std::max(0, reach_[q] - flat_ - 1);
+        for (int c = 0; c < nc_; ++c) sweep_[q*nc_ + c] = acc[c];
+    }
+    for (std::size_t i = 0; i < eval_.size; ++i)
+    {
+        double* o = &out[i*nc_];
+        affine_.addTo(eval_[i], o);
+        const double* v = &sweep_[std::size_t(evalPos_[i])*nc_];
+        for (int c = 0; c < nc_; ++c) o[c] += v[c];
     }
 }
 
@@ -966,10 +990,10 @@ std::vector<levelStats> multilevel<D>::stats() const
 template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
-    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + flatPhi_.capacity())*sizeof(double)
+    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + flatPhi_.capacity() + foldScratch_.capacity() + sweep_.capacity())*sizeof(double)
         + active_.capacity() + mask_.capacity() + reach_.capacity() + deepTiles_.capacity()*sizeof(stencilTiles<D>)
-        + (ctrlOrder_.capacity() + evalOrder_.capacity())*sizeof(std::uint32_t)
-        + evalU0_.capacity()*sizeof(point<D>));
+        + (ctrlOrder_.capacity() + evalOrder_.capacity() + evalPos_.capacity())*sizeof(std::uint32_t)
+        + (ctrlU0_.capacity() + evalU0_.capacity())*sizeof(point<D>) + stencils_.capacity()*sizeof(stencil<D>));
     for (const auto& L : levels_) b += L->stats.bytes;
     return b;
 }

@@ -109,7 +109,10 @@ class multilevel
     std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
     std::vector<std::vector<const double*>> queryGroups_; ///< the points of each cluster
     std::vector<std::uint32_t> ctrlOrder_, evalOrder_; ///< active control / evaluation points in space-filling-curve order
-    std::vector<point<D>> evalU0_;      ///< level-0 local coordinates of the evaluation points, in evalOrder_
+    std::vector<point<D>> ctrlU0_, evalU0_; ///< level-0 local coordinates of the active control / evaluation points, in ctrlOrder_ / evalOrder_
+    std::vector<stencil<D>> stencils_;  ///< a fit's control-point stencils at the current level
+    std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_
+    mutable std::vector<double> sweep_; ///< evaluate()'s lattice values in evalOrder_ (kept: no new pages per call)
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
     /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed into
@@ -120,9 +123,9 @@ class multilevel
     int flat_ = -1;
     point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
     indexBox<D> flatBox_;
-    std::vector<double> flatPhi_;
-    /// Per evaluation point: the first level above flat_ whose lattice has no
-    /// tile at its stencil (none finer has one either), for reachKey_
+    std::vector<double> flatPhi_, foldScratch_;
+    /// Per evaluation point, in evalOrder_: the first level above flat_ whose
+    /// lattice has no tile at its stencil (none finer has one either), for reachKey_
     std::vector<std::uint8_t> reach_;
     /// Their tiles at levels flat_ + 1 .. reach - 1, point after point in evalOrder_
     std::vector<stencilTiles<D>> deepTiles_;

@@ -98,10 +98,16 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     const label nPoints = mesh.nPoints();
     const vectorField& disp = pointDisplacement.primitiveField();
 
-    labelList fixed(nPoints, 0);
-    value_ = vectorField(nPoints, Zero);
+    // The per-point arrays keep their storage from step to step (no new
+    // pages for the mesh-sized arrays at every step)
+    labelList& fixed = fixedSync_;
+    fixed.setSize(nPoints);
+    fixed = 0;
+    value_.setSize(nPoints);
+    value_ = Zero;
     wordHashSet badPatches;
-    slide_ = List<pointConstraint>(nPoints, pointConstraint());
+    slide_.setSize(nPoints);
+    slide_ = pointConstraint();
 
     forAll(pointDisplacement.boundaryField(), patchi)
     {

@@ -140,6 +140,10 @@ void Foam::interpolatingMotionSolver::use
     std::unique_ptr<boundaryConstraints>& current =
         slot == 0 ? constraintsPtr_ : refitPtr_;
     const bool changed = !current || !set->sameControls(*current);
+    if (slot == 0 && current)
+    {
+        spare_ = std::move(current);
+    }
     current = std::move(set);
     slot_ = slot;
     if (returnReduce(changed, orOp<bool>()) || !planned_[slot])
@@ -208,12 +212,23 @@ void Foam::interpolatingMotionSolver::solve()
     pointDisplacement_.boundaryFieldRef().updateCoeffs();
     pointDisplacement_.correctBoundaryConditions();
 
-    std::unique_ptr<boundaryConstraints> bc
-    (
-        new boundaryConstraints(pointDisplacement_)
-    );
+    std::unique_ptr<boundaryConstraints> bc;
+    if (spare_)
+    {
+        bc = std::move(spare_);
+        bc->update(pointDisplacement_);
+    }
+    else
+    {
+        bc.reset(new boundaryConstraints(pointDisplacement_));
+        // and the one the next step updates in place (set-up work, not
+        // the second step's)
+        spare_.reset(new boundaryConstraints(pointDisplacement_));
+    }
 
-    vectorField displacement(points0().size(), Zero);
+    vectorField& displacement = displacement_;
+    displacement.setSize(points0().size());
+    displacement = Zero;
     slot_ = 0;
     if (bc->nControlGlobal() == 0)
     {
@@ -248,7 +263,9 @@ void Foam::interpolatingMotionSolver::solve()
     }
     constraintsPtr_->constrain(displacement);
 
-    const label nInverted = nInvertedCells(points0() + displacement);
+    newPoints_ = points0();
+    newPoints_ += displacement;
+    const label nInverted = nInvertedCells(newPoints_);
     if (nInverted > 0)
     {
         if (invertedCellsFatal_)

@@ -152,7 +152,7 @@ std::string Foam::multilevelBSplineMotionSolver::morph
 {
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
-    std::vector<double> out;
+    std::vector<double>& out = values_;
     double evalSeconds = 0;
     try
     {
