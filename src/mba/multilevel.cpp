@@ -186,16 +186,19 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
             return s;
         };
         if (path([](std::size_t q) { return q; }) <= 1.5*path([&](std::size_t q) { return evalOrder_[q]; }))
-            for (std::size_t q = 0; q < eval_.size; ++q) evalOrder_[q] = std::uint32_t(q);
+            evalOrder_ = std::vector<std::uint32_t>();
+        else
+        {
+            evalPos_.resize(eval_.size);
+            for (std::size_t q = 0; q < eval_.size; ++q) evalPos_[evalOrder_[q]] = std::uint32_t(q);
+        }
     }
     evalLo0_.fill(HUGE_VAL);
     evalHi0_.fill(-HUGE_VAL);
     evalU0_.reserve(eval_.size);
-    evalPos_.resize(eval_.size);
-    for (std::size_t q = 0; q < evalOrder_.size(); ++q) evalPos_[evalOrder_[q]] = std::uint32_t(q);
-    for (const std::uint32_t i : evalOrder_)
+    for (std::size_t q = 0; q < eval_.size; ++q)
     {
-        const point<D> u = dom_.local0(eval_[i]);
+        const point<D> u = dom_.local0(eval_[evalAt(q)]);
         evalU0_.push_back(u);
         for (int d = 0; d < D; ++d) { evalLo0_[d] = std::min(evalLo0_[d], u[d]); evalHi0_[d] = std::max(evalHi0_[d], u[d]); }
     }
@@ -895,7 +898,7 @@ void multilevel<D>::fold()
     reach_.assign(eval_.size, 0);
     deepTiles_.clear();
     stencilTiles<D> tid;
-    for (std::size_t q = 0; q < evalOrder_.size(); ++q)
+    for (std::size_t q = 0; q < eval_.size; ++q)
     {
         const point<D>& u0 = evalU0_[q];
         int k = flat_ + 1;
@@ -930,17 +933,19 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
     out.assign(eval_.size*nc_, 0.0);
     if (flat_ < 0)
     {
-        for (const std::uint32_t i : evalOrder_) addLevels(eval_[i], &out[i*nc_], report_.levels);
+        for (std::size_t q = 0; q < eval_.size; ++q) addLevels(eval_[evalAt(q)], &out[evalAt(q)*nc_], report_.levels);
         return;
     }
-    // The lattices in evalOrder_ (the flat one, then the finer levels that
-    // have tiles at the point) into sweep_, then, in the points' own order,
-    // the affine part plus the lattices' value: the reads and writes of the
-    // points and results are in sequence, only sweep_ is gathered
-    sweep_.resize(eval_.size*nc_);
+    // The lattices (the flat one, then the finer levels that have tiles at
+    // the point) point after point in evaluation order. In the points' own
+    // order the results are written in place; in curve order into sweep_,
+    // from which the points' own order then gathers them (the reads and
+    // writes of points and results stay in sequence)
+    const bool own = evalOrder_.empty();
+    if (!own) sweep_.resize(eval_.size*nc_);
     const double sf = std::ldexp(1.0, flat_);
     const stencilTiles<D>* deep = deepTiles_.data();
-    for (std::size_t q = 0; q < evalOrder_.size(); ++q)
+    for (std::size_t q = 0; q < eval_.size; ++q)
     {
         const point<D>& u0 = evalU0_[q];
         double acc[3] = {0, 0, 0};
@@ -952,9 +957,11 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
             evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), acc);
         }
         deep += std::max(0, reach_[q] - flat_ - 1);
-        for (int c = 0; c < nc_; ++c) sweep_[q*nc_ + c] = acc[c];
+        double* o = own ? &out[q*nc_] : &sweep_[q*nc_];
+        if (own) affine_.addTo(eval_[q], o);
+        for (int c = 0; c < nc_; ++c) o[c] += acc[c];
     }
-    for (std::size_t i = 0; i < eval_.size; ++i)
+    for (std::size_t i = 0; i < eval_.size && !own; ++i)
     {
         double* o = &out[i*nc_];
         affine_.addTo(eval_[i], o);

@@ -108,11 +108,13 @@ class multilevel
     affineFit<D> affine_;
     std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
     std::vector<std::vector<const double*>> queryGroups_; ///< the points of each cluster
-    std::vector<std::uint32_t> ctrlOrder_, evalOrder_; ///< active control / evaluation points in space-filling-curve order
+    std::vector<std::uint32_t> ctrlOrder_; ///< active control points in space-filling-curve order
+    std::vector<std::uint32_t> evalOrder_; ///< evaluation points in curve order (empty: their own order)
+    std::size_t evalAt(std::size_t q) const { return evalOrder_.empty() ? q : evalOrder_[q]; }
     std::vector<point<D>> ctrlU0_, evalU0_; ///< level-0 local coordinates of the active control / evaluation points, in ctrlOrder_ / evalOrder_
     std::vector<stencil<D>> stencils_;  ///< a fit's control-point stencils at the current level
-    std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_
-    mutable std::vector<double> sweep_; ///< evaluate()'s lattice values in evalOrder_ (kept: no new pages per call)
+    std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_ (curve order only)
+    mutable std::vector<double> sweep_; ///< evaluate()'s values in curve order (kept: no new pages per call)
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
     /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed into
