@@ -957,9 +957,16 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
             evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), acc);
         }
         deep += std::max(0, reach_[q] - flat_ - 1);
-        double* o = own ? &out[q*nc_] : &sweep_[q*nc_];
-        if (own) affine_.addTo(eval_[q], o);
-        for (int c = 0; c < nc_; ++c) o[c] += acc[c];
+        if (own)
+        {
+            double* o = &out[q*nc_];
+            affine_.addTo(eval_[q], o);
+            for (int c = 0; c < nc_; ++c) o[c] += acc[c];
+        }
+        else
+        {
+            for (int c = 0; c < nc_; ++c) sweep_[q*nc_ + c] = acc[c];
+        }
     }
     for (std::size_t i = 0; i < eval_.size && !own; ++i)
     {
