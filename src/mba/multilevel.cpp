@@ -542,9 +542,11 @@ void multilevel<D>::applyLevel(level& L)
         double rr[3];
         for (int c = 0; c < nc_; ++c)
             rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        // rr by value: the stores through dl cannot alias it
-        detail::visitStencil(tiles[pos++], st, [delta, rr, nc = nc_](std::int64_t id, int n, double w) {
-            const double w3 = w*w*w;
+        // w^3 as the product of the directions' cubed weights; rr by value:
+        // the stores through dl cannot alias it
+        stencil<D> cubed = st;
+        for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
+        detail::visitStencil(tiles[pos++], cubed, [delta, rr, nc = nc_](std::int64_t id, int n, double w3) {
             double* dl = delta + (id*npt + n)*nc;
             for (int c = 0; c < nc; ++c) dl[c] += w3*rr[c];
         });
@@ -581,8 +583,9 @@ void multilevel<D>::applyLevel(level& L)
                 const double sw = st.sumSquares();
                 double rr[3];
                 for (int c = 0; c < nc_; ++c) rr[c] = x[D + c] != 0 ? got[r][g*nc_ + c]/sw : 0.0;
-                detail::visitStencil(L.ghostTiles[r][g], st, [&dl, rr, nc = nc_](std::int64_t id, int n, double w) {
-                    const double w3 = w*w*w;
+                stencil<D> cubed = st;      // as the owner adds them
+                for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
+                detail::visitStencil(L.ghostTiles[r][g], cubed, [&dl, rr, nc = nc_](std::int64_t id, int n, double w3) {
                     double* d = &dl[(id*npt + n)*nc];
                     for (int c = 0; c < nc; ++c) d[c] += w3*rr[c];
                 });
