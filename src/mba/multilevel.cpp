@@ -78,6 +78,24 @@ struct multilevel<D>::level
 
 namespace {
 
+/// One control point's part of the partial delta: w^3 r/sum(w^2) on each node
+/// of its stencil (rr = r/sum(w^2) per component), w^3 as the product of the
+/// directions' cubed weights. The point's owner and a rank holding it as a
+/// ghost both add it through here: bitwise the same sums.
+template <int D>
+inline __attribute__((always_inline))
+void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile;
+    stencil<D> cubed = st;
+    for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
+    const double r[3] = {rr[0], rr[1], rr[2]};  // a copy: the stores through dl cannot alias it
+    detail::visitStencil(tid, cubed, [delta, nc, r](std::int64_t id, int n, double w3) {
+        double* dl = delta + (id*npt + n)*nc;
+        for (int c = 0; c < nc; ++c) dl[c] += w3*r[c];
+    });
+}
+
 /// Morton code of a point's level-0 local coordinates on a 2^(63/D) grid
 template <int D>
 std::uint64_t morton(const point<D>& u, const domain<D>& dom)
@@ -539,17 +557,10 @@ void multilevel<D>::applyLevel(level& L)
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
         stencils_[pos] = st;    // again for the residuals below
         const double sw = st.sumSquares();
-        double rr[3];
+        double rr[3] = {0, 0, 0};
         for (int c = 0; c < nc_; ++c)
             rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        // w^3 as the product of the directions' cubed weights; rr by value:
-        // the stores through dl cannot alias it
-        stencil<D> cubed = st;
-        for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
-        detail::visitStencil(tiles[pos++], cubed, [delta, rr, nc = nc_](std::int64_t id, int n, double w3) {
-            double* dl = delta + (id*npt + n)*nc;
-            for (int c = 0; c < nc; ++c) dl[c] += w3*rr[c];
-        });
+        scatter<D>(delta, nc_, tiles[pos++], st, rr);
     });
 
     if (!direct)
@@ -581,14 +592,9 @@ void multilevel<D>::applyLevel(level& L)
                 const double* x = &L.ghostX[r][g*stride];
                 const stencil<D> st(scaled<D>(dom_.local0(x), L.scale).data());
                 const double sw = st.sumSquares();
-                double rr[3];
+                double rr[3] = {0, 0, 0};
                 for (int c = 0; c < nc_; ++c) rr[c] = x[D + c] != 0 ? got[r][g*nc_ + c]/sw : 0.0;
-                stencil<D> cubed = st;      // as the owner adds them
-                for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
-                detail::visitStencil(L.ghostTiles[r][g], cubed, [&dl, rr, nc = nc_](std::int64_t id, int n, double w3) {
-                    double* d = &dl[(id*npt + n)*nc];
-                    for (int c = 0; c < nc; ++c) d[c] += w3*rr[c];
-                });
+                scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr);     // as the owner does
             }
             got[r].swap(dl);
         }
