@@ -133,6 +133,51 @@ TEST_CASE("sparse storage grows with the surface, not the volume", "[core]")
     CHECK_FALSE(st.back().dense);
 }
 
+namespace {
+
+template <int D>
+void flatEqualsLevels()
+{
+    // Control points on the faces of the box (the morphing case: sparse fine
+    // levels) with a sharp feature, evaluation points inside; the planned
+    // evaluation (levels 0..flat refined into one plain lattice, then the
+    // finer levels) against the level-by-level sum at each point
+    std::vector<point<D>> c;
+    for (const auto& x : randomPoints<D>(3000, 41))
+    {
+        point<D> y = x;
+        y[0] = x[0] < 0.5 ? 0.0 : 1.0;
+        c.push_back(y);
+    }
+    const auto e = randomPoints<D>(4000, 42);
+    std::vector<double> v = smoothValues<D>(c, 3);
+    for (std::size_t i = 0; i < c.size(); ++i) v[3*i] += std::exp(-200*std::pow(c[i][1] - 0.4, 2));
+    params p;
+    p.tolerance = 1e-10;
+    multilevel<D> m(serial, p, 3, c, {}, e);
+    const fitReport& r = m.fit(v);
+    REQUIRE(r.levels >= 6);
+    std::vector<double> planned;
+    m.evaluate(planned);
+    double scale = 0;
+    for (double x : planned) scale = std::max(scale, std::abs(x));
+    REQUIRE(scale > 0.1);
+    for (std::size_t i = 0; i < e.size(); ++i)
+    {
+        double one[3];
+        m.evaluate(e[i].data(), one);
+        for (int k = 0; k < 3; ++k) REQUIRE_THAT(planned[3*i + k], Catch::WithinAbs(one[k], 1e-12*scale));
+    }
+}
+
+} // namespace
+
+TEST_CASE("planned evaluation (flat lattice + finer levels) equals the sum of the levels", "[core]")
+{
+    flatEqualsLevels<2>();
+    flatEqualsLevels<3>();
+}
+
 TEST_CASE("applying new values through the plan equals a fresh fit", "[core]")
 {
     const auto c = randomPoints<3>(2000, 31);
