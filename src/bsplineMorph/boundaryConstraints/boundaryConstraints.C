@@ -323,9 +323,13 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
 }
 
 
-bool Foam::boundaryConstraints::sameControls(const boundaryConstraints& other) const
+bool Foam::boundaryConstraints::sameControls
+(
+    const labelList& points,
+    const std::vector<std::uint8_t>& mask
+) const
 {
-    return controlPoints_ == other.controlPoints_ && mask_ == other.mask_;
+    return controlPoints_ == points && mask_ == mask;
 }
 
 

@@ -131,20 +131,8 @@ const double* Foam::interpolatingMotionSolver::evalCoordinates() const
 }
 
 
-void Foam::interpolatingMotionSolver::use
-(
-    const label slot,
-    std::unique_ptr<boundaryConstraints> set
-)
+void Foam::interpolatingMotionSolver::use(const label slot, const bool changed)
 {
-    std::unique_ptr<boundaryConstraints>& current =
-        slot == 0 ? constraintsPtr_ : refitPtr_;
-    const bool changed = !current || !set->sameControls(*current);
-    if (slot == 0 && current)
-    {
-        spare_ = std::move(current);
-    }
-    current = std::move(set);
     slot_ = slot;
     if (returnReduce(changed, orOp<bool>()) || !planned_[slot])
     {
@@ -212,35 +200,35 @@ void Foam::interpolatingMotionSolver::solve()
     pointDisplacement_.boundaryFieldRef().updateCoeffs();
     pointDisplacement_.correctBoundaryConditions();
 
-    std::unique_ptr<boundaryConstraints> bc;
-    if (spare_)
+    // The control set, updated in place after the first step (its
+    // mesh-sized arrays kept); whether its points or masks changed
+    bool changed = true;
+    if (constraintsPtr_)
     {
-        bc = std::move(spare_);
-        bc->update(pointDisplacement_);
+        const labelList points(constraintsPtr_->controlPoints());
+        const std::vector<std::uint8_t> mask(constraintsPtr_->mask());
+        constraintsPtr_->update(pointDisplacement_);
+        changed = !constraintsPtr_->sameControls(points, mask);
     }
     else
     {
-        bc.reset(new boundaryConstraints(pointDisplacement_));
-        // and the one the next step updates in place (set-up work, not
-        // the second step's)
-        spare_.reset(new boundaryConstraints(pointDisplacement_));
+        constraintsPtr_.reset(new boundaryConstraints(pointDisplacement_));
     }
 
     vectorField& displacement = displacement_;
     displacement.setSize(points0().size());
     displacement = Zero;
     slot_ = 0;
-    if (bc->nControlGlobal() == 0)
+    if (constraintsPtr_->nControlGlobal() == 0)
     {
         WarningInFunction
             << "No control points: no patch of pointDisplacement fixes a value"
             << " or slides; the mesh keeps its initial points" << endl;
-        constraintsPtr_ = std::move(bc);
         clearPlan();
     }
     else
     {
-        use(0, std::move(bc));
+        use(0, changed);
         summary = interpolate(displacement);
 
         // Sliding planes not along the axes: project, then fit again with
@@ -249,14 +237,14 @@ void Foam::interpolatingMotionSolver::solve()
         if (constraintsPtr_->nProjectedGlobal() > 0)
         {
             constraintsPtr_->constrain(displacement);
-            use
+            std::unique_ptr<boundaryConstraints> refit
             (
-                1,
-                std::unique_ptr<boundaryConstraints>
-                (
-                    new boundaryConstraints(*constraintsPtr_, displacement)
-                )
+                new boundaryConstraints(*constraintsPtr_, displacement)
             );
+            const bool refitChanged = !refitPtr_
+             || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
+            refitPtr_ = std::move(refit);
+            use(1, refitChanged);
             summary += "; re-fit with the projected sliding points: " + interpolate(displacement);
             slot_ = 0;
         }
