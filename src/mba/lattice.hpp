@@ -275,16 +275,5 @@ void insertStencil(tileLayout<D>& L, const stencil<D>& st)
     forEachIndex<D>(st.tiles(), [&](const index<D>& t) { L.findOrInsert(t); });
 }
 
-/// Visit the stencil nodes that exist in the layout: f(tileId, nodeInTile, weight).
-/// Returns whether any tile existed.
-template <int D, class F>
-bool forStencil(const tileLayout<D>& L, const stencil<D>& st, F&& f)
-{
-    stencilTiles<D> tid;
-    if (!findTiles(L, st, tid)) return false;
-    detail::visitStencil(tid, st, f);
-    return true;
-}
-
 } // namespace mba
 #endif

@@ -282,14 +282,18 @@ void multilevel<D>::buildLevel(int k)
     for (int d = 0; d < D; ++d) nodes[d] = dom_.nodes(k, d);
     collectively(comm_, [&] { L.own.init(nodes, false); });
 
-    // This rank's tiles and partial omega
+    // This rank's tiles, the tiles of each control point's stencil (found
+    // once: for omega, the ghosts and the fits) and partial omega
     forOwnStencils(L, [&](std::size_t, const stencil<D>& st) {
         insertStencil(L.own, st);
     });
     const std::int64_t nOwn = L.own.size();
+    std::vector<stencilTiles<D>> ownIds(ctrlOrder_.size());
     std::vector<double> ownW(nOwn*npt*nw_, 0.0);
+    std::size_t pos = 0;
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
-        forStencil(L.own, st, [&](std::int64_t id, int n, double w) {
+        findTiles(L.own, st, ownIds[pos]);
+        detail::visitStencil(ownIds[pos++], st, [&](std::int64_t id, int n, double w) {
             double* o = &ownW[(id*npt + n)*nw_];
             if (nw_ == 1) o[0] += w*w;
             else for (int c = 0; c < nw_; ++c) if (mask_[i*nc_ + c]) o[c] += w*w;
@@ -413,12 +417,9 @@ void multilevel<D>::buildLevel(int k)
             std::fill(asked.begin(), asked.end(), 0);
             for (const std::int64_t id : L.sendTiles[r]) asked[id] = 1;
             std::vector<std::uint32_t> g;
-            stencilTiles<D> tid;
-            forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
-                findTiles(L.own, st, tid);
-                for (const std::int32_t id : tid)
-                    if (id >= 0 && asked[id]) { g.push_back(std::uint32_t(i)); break; }
-            });
+            for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+                for (const std::int32_t id : ownIds[q])
+                    if (id >= 0 && asked[id]) { g.push_back(ctrlOrder_[q]); break; }
             if (g.size() >= std::size_t(npt)*L.sendTiles[r].size()) continue;
             for (const std::uint32_t i : g)
             {
@@ -489,14 +490,14 @@ void multilevel<D>::buildLevel(int k)
     }
     L.phi.assign(L.view.size()*npt*nc_, 0.0);
     precondition(L.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
-    L.ctrlView.resize(ctrlOrder_.size());
-    L.ctrlOwn.resize(P > 1 ? ctrlOrder_.size() : 0);
-    std::size_t pos = 0;
-    forOwnStencils(L, [&](std::size_t, const stencil<D>& st) {
-        findTiles(L.view, st, L.ctrlView[pos]);
-        if (P > 1) findTiles(L.own, st, L.ctrlOwn[pos]);
-        ++pos;
-    });
+    if (L.ownIsView) L.ctrlView = std::move(ownIds);
+    else
+    {
+        L.ctrlView.resize(ctrlOrder_.size());
+        pos = 0;
+        forOwnStencils(L, [&](std::size_t, const stencil<D>& st) { findTiles(L.view, st, L.ctrlView[pos++]); });
+        if (P > 1) L.ctrlOwn = std::move(ownIds);
+    }
 
     levelStats& s = L.stats;
     s.level = k;
