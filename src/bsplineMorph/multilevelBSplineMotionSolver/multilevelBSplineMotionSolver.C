@@ -21,8 +21,6 @@ License
 #include "Enum.H"
 #include "clockTime.H"
 
-#include <chrono>
-
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
 namespace Foam
@@ -153,13 +151,13 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
     std::vector<double>& out = values_;
-    double evalSeconds = 0;
+    scalar evalSeconds = 0;
     try
     {
         plan.fit(bc.values());
-        const auto t0 = std::chrono::steady_clock::now();
+        const clockTime timer;
         plan.evaluate(out);
-        evalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        evalSeconds = timer.elapsedTime();
     }
     catch (const std::exception& e)
     {
