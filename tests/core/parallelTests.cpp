@@ -191,13 +191,14 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
     }
     REQUIRE(levels >= 7);
     const int P = 8;
+    const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);
     std::vector<std::int64_t> recv(P), gatherAll(P);
     runSimulated(P, [&](const communicator& comm) {
         std::vector<point<3>> cl, el;
         std::vector<double> vl;
         for (std::size_t i = 0; i < c.size(); ++i)
-            if (std::min(P - 1, int(c[i][0]*P)) == comm.rank()) { cl.push_back(c[i]); vl.push_back(v[i]); }
-        for (const auto& x : e) if (std::min(P - 1, int(x[0]*P)) == comm.rank()) el.push_back(x);
+            if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.push_back(v[i]); }
+        for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
         multilevel<3> m(comm, p, 1, cl, {}, el);
         const fitReport& r = m.fit(vl);
         REQUIRE(r.levels == levels);
@@ -224,13 +225,14 @@ TEST_CASE("fine levels exchange ghost residuals, not tiles; coarse levels tiles"
     p.maxLevels = 9;
     for (const int P : {2, 4, 8})
     {
+        const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);
         std::vector<std::vector<levelStats>> st(P);
         runSimulated(P, [&](const communicator& comm) {
             std::vector<point<3>> cl, el;
             std::vector<double> vl;
             for (std::size_t i = 0; i < c.size(); ++i)
-                if (std::min(P - 1, int(c[i][0]*P)) == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
-            for (const auto& x : e) if (std::min(P - 1, int(x[0]*P)) == comm.rank()) el.push_back(x);
+                if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
+            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
             multilevel<3> m(comm, p, 3, cl, {}, el);
             m.fit(vl);
             st[comm.rank()] = m.stats();
