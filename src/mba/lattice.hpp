@@ -21,7 +21,7 @@ constexpr int tileEdge = 4;
 
 template <int D> struct tileSize;
 template <> struct tileSize<2> { static constexpr int nodes = tileEdge*tileEdge; };
-static_assert(tileEdge == 2 || tileEdge == 4, "a stencil spans at most 3 tiles per direction");
+static_assert(tileEdge == 4, "the kernels take a stencil row as at most two tile rows of 4 nodes");
 template <> struct tileSize<3> { static constexpr int nodes = tileEdge*tileEdge*tileEdge; };
 
 template <int D>
@@ -117,14 +117,15 @@ template <int D> struct stencil
 
     stencil() = default;
 
-    /// From level-local coordinates u (cell floor(u), s = u - floor(u))
+    /// From level-local coordinates u >= 0 (as domain::local0 makes them):
+    /// cell floor(u), s = u - floor(u); floor as truncation, which is one
+    /// instruction on every x86-64 (std::floor is a call without SSE4.1)
     explicit stencil(const double* u)
     {
         for (int d = 0; d < D; ++d)
         {
-            const double f = std::floor(u[d]);
-            base[d] = std::int64_t(f);
-            cubicBasis(u[d] - f, w[d]);
+            base[d] = std::int64_t(u[d]);
+            cubicBasis(u[d] - double(base[d]), w[d]);
         }
     }
 
@@ -176,71 +177,186 @@ bool findTiles(const tileLayout<D>& L, const stencil<D>& st, stencilTiles<D>& ti
 }
 
 namespace detail {
-// Per direction: which of the (up to 2) touched tiles holds stencil node a, and where
-struct split1
+/// Rows of N doubles as vectors of two (GCC's vector extension: SSE2 on
+/// x86-64, NEON on arm64), kept in registers; per lane the same arithmetic as
+/// scalar code
+typedef double v2d __attribute__((vector_size(16)));
+typedef double v2du __attribute__((vector_size(16), aligned(8), may_alias)); ///< unaligned, in arrays of double
+template <int N> struct vrow
 {
-    int ta[4], oa[4];
-    explicit split1(std::int64_t base)
+    static_assert(N % 2 == 0, "rows of 4 nodes");
+    v2d v[N/2];
+
+    /// The row p[0..N)
+    static inline __attribute__((always_inline)) vrow load(const double* p)
     {
-        const std::int64_t t0 = base/tileEdge;
-        for (int a = 0; a < 4; ++a)
-        {
-            const std::int64_t n = base + a;
-            ta[a] = int(n/tileEdge - t0);
-            oa[a] = int(n - (n/tileEdge)*tileEdge);
-        }
+        vrow r;
+        const v2du* q = reinterpret_cast<const v2du*>(p);
+        for (int i = 0; i < N/2; ++i) r.v[i] = q[i];
+        return r;
+    }
+
+    /// Stores the row to p[0..N)
+    void store(double* p) const
+    {
+        v2du* q = reinterpret_cast<v2du*>(p);
+        for (int i = 0; i < N/2; ++i) q[i] = v[i];
     }
 };
 
+/// a += w*b
+template <int N>
+inline __attribute__((always_inline)) void axpy(vrow<N>& a, double w, const vrow<N>& b)
+{
+    for (int i = 0; i < N/2; ++i) a.v[i] += w*b.v[i];
+}
+
+/// a += w*p (p a row in memory)
+template <int N>
+inline __attribute__((always_inline)) void axpy(vrow<N>& a, double w, const double* p)
+{
+    axpy<N>(a, w, vrow<N>::load(p));
+}
+
+/// The rows of a stencil along its last direction: f(t, n, w) for each of
+/// its 4^(D-1) rows, with t the entry in stencilTiles of the tile that holds
+/// the row's first nodes (the next tile along the last direction is t + 1),
+/// n the node in that tile where the row's tile-row starts (last coordinate
+/// 0: a row of a tile is 4 contiguous nodes) and w the product of the row's
+/// weights in the other directions
+template <class F>
+inline __attribute__((always_inline)) void forRows(const stencil<3>& st, F&& f)
+{
+    const int ox = int(st.base[0] & 3), oy = int(st.base[1] & 3);
+    for (int a = 0; a < 4; ++a)
+    {
+        const int ta = ((ox + a) >> 2)*2, na = ((ox + a) & 3)*tileEdge;
+        for (int b = 0; b < 4; ++b)
+            f((ta + ((oy + b) >> 2))*2, (na + ((oy + b) & 3))*tileEdge, st.w[0][a]*st.w[1][b]);
+    }
+}
+
+template <class F>
+inline __attribute__((always_inline)) void forRows(const stencil<2>& st, F&& f)
+{
+    const int ox = int(st.base[0] & 3);
+    for (int a = 0; a < 4; ++a) f(((ox + a) >> 2)*2, ((ox + a) & 3)*tileEdge, st.w[0][a]);
+}
+
 /// Visits the stencil's nodes in existing tiles: f(tileId, nodeInTile, weight)
-template <class F>
-inline __attribute__((always_inline)) void visitStencil(const stencilTiles<3>& tid, const stencil<3>& st, F&& f)
+/// (for the plan; the per-fit kernels below work on whole tile rows)
+template <int D, class F>
+void visitStencil(const stencilTiles<D>& tid, const stencil<D>& st, F&& f)
 {
-    const split1 x(st.base[0]), y(st.base[1]), z(st.base[2]);
-    for (int a = 0; a < 4; ++a)
-    {
-        const int ia = x.ta[a]*2, oa = x.oa[a]*tileEdge;
-        const double wa = st.w[0][a];
-        for (int b = 0; b < 4; ++b)
+    const int oz = int(st.base[D - 1] & 3);
+    forRows(st, [&](int t, int n, double w) {
+        for (int c = 0; c < 4; ++c)
         {
-            const int iab = (ia + y.ta[b])*2, oab = (oa + y.oa[b])*tileEdge;
-            const double wab = wa*st.w[1][b];
-            for (int c = 0; c < 4; ++c)
-            {
-                const std::int32_t id = tid[iab + z.ta[c]];
-                if (id >= 0) f(std::int64_t(id), oab + z.oa[c], wab*st.w[2][c]);
-            }
+            const std::int32_t id = tid[t + ((oz + c) >> 2)];
+            if (id >= 0) f(std::int64_t(id), n + ((oz + c) & 3), w*st.w[D - 1][c]);
         }
+    });
+}
+
+/// A stencil row whose last-direction nodes start at node OZ of a tile row
+/// (NC values a node, the tile row at p0) and go on at node 0 of the next
+/// tile's row (p1, used when OZ > 0): the 4 nodes' values in stencil order
+template <int NC, int OZ>
+inline __attribute__((always_inline)) vrow<4*NC> loadSplit(const double* p0, const double* p1)
+{
+    constexpr int L = (4 - OZ)*NC;  // values from p0 (from p0[OZ*NC])
+    vrow<4*NC> r;
+    for (int i = 0; i < 2*NC; ++i)
+    {
+        const int j = 2*i;
+        if (j + 1 < L) r.v[i] = *reinterpret_cast<const v2du*>(p0 + OZ*NC + j);
+        else if (j >= L) r.v[i] = *reinterpret_cast<const v2du*>(p1 + (j - L));
+        else r.v[i] = v2d{p0[OZ*NC + j], p1[0]};
+    }
+    return r;
+}
+
+/// The same split row += w*a
+template <int NC, int OZ>
+inline __attribute__((always_inline)) void addSplit(double* p0, double* p1, double w, const vrow<4*NC>& a)
+{
+    constexpr int L = (4 - OZ)*NC;
+    for (int i = 0; i < 2*NC; ++i)
+    {
+        const int j = 2*i;
+        const v2d x = w*a.v[i];
+        if (j + 1 < L) *reinterpret_cast<v2du*>(p0 + OZ*NC + j) += x;
+        else if (j >= L) *reinterpret_cast<v2du*>(p1 + (j - L)) += x;
+        else { p0[OZ*NC + j] += x[0]; p1[0] += x[1]; }
     }
 }
 
-template <class F>
-inline __attribute__((always_inline)) void visitStencil(const stencilTiles<2>& tid, const stencil<2>& st, F&& f)
+/// The value at a stencil (NC values per node), the stencil's first node at
+/// OZ along the last direction within its tile: its rows are summed with the
+/// other directions' weights (each row read as one vector: its tile row from
+/// OZ on, then the next tile's row), then weighted along the last direction.
+/// Absent tiles read as zero.
+template <int D, int NC, int OZ>
+void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
 {
-    const split1 x(st.base[0]), y(st.base[1]);
-    for (int a = 0; a < 4; ++a)
-    {
-        const int ia = x.ta[a]*2, oa = x.oa[a]*tileEdge;
-        for (int b = 0; b < 4; ++b)
-        {
-            const std::int32_t id = tid[ia + y.ta[b]];
-            if (id >= 0) f(std::int64_t(id), oa + y.oa[b], st.w[0][a]*st.w[1][b]);
-        }
-    }
+    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    static constexpr double zero[R] = {};
+    auto row = [phi, &tid](int t, int n) {
+        const std::int32_t id = tid[t];
+        return id >= 0 ? phi + (std::int64_t(id)*npt + n)*NC : zero;
+    };
+    vrow<R> acc = {};
+    forRows(st, [&](int t, int n, double w) {
+        axpy<R>(acc, w, loadSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : zero));
+    });
+    double s[R];
+    acc.store(s);
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) out[k] += st.w[D - 1][c]*s[c*NC + k];
 }
 
-/// The value at a stencil (NC values per node). visitStencil is inlined here:
-/// out of line, the accumulators behind its reference cost 20% of the sweep.
 template <int D, int NC>
 void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile;
-    double acc[NC] = {};
-    visitStencil(tid, st, [phi, &acc](std::int64_t id, int n, double w) {
-        const double* p = phi + (id*npt + n)*NC;
-        for (int v = 0; v < NC; ++v) acc[v] += w*p[v];
+    switch (st.base[D - 1] & 3)
+    {
+        case 0: sweepStencil<D, NC, 0>(phi, tid, st, out); break;
+        case 1: sweepStencil<D, NC, 1>(phi, tid, st, out); break;
+        case 2: sweepStencil<D, NC, 2>(phi, tid, st, out); break;
+        default: sweepStencil<D, NC, 3>(phi, tid, st, out);
+    }
+}
+
+/// Adds w_n r (NC values) to each node n of the stencil, w_n the product of
+/// the stencil's weights (given cubed, for the fit's delta), row by row as the
+/// sweep reads them. Nodes in absent tiles (id < 0) are left out.
+template <int D, int NC, int OZ>
+void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    double u[R], sink[R] = {};
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) u[c*NC + k] = st.w[D - 1][c]*r[k];
+    const vrow<R> v = vrow<R>::load(u);
+    auto row = [delta, &tid, &sink](int t, int n) {
+        const std::int32_t id = tid[t];
+        return id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
+    };
+    forRows(st, [&](int t, int n, double w) {
+        addSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : sink, w, v);
     });
-    for (int v = 0; v < NC; ++v) out[v] += acc[v];
+}
+
+template <int D, int NC>
+void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r)
+{
+    switch (st.base[D - 1] & 3)
+    {
+        case 0: scatterStencil<D, NC, 0>(delta, tid, st, r); break;
+        case 1: scatterStencil<D, NC, 1>(delta, tid, st, r); break;
+        case 2: scatterStencil<D, NC, 2>(delta, tid, st, r); break;
+        default: scatterStencil<D, NC, 3>(delta, tid, st, r);
+    }
 }
 } // namespace detail
 

@@ -83,17 +83,16 @@ namespace {
 /// directions' cubed weights. The point's owner and a rank holding it as a
 /// ghost both add it through here: bitwise the same sums.
 template <int D>
-inline __attribute__((always_inline))
-void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
+inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile;
     stencil<D> cubed = st;
     for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
-    const double r[3] = {rr[0], rr[1], rr[2]};  // a copy: the stores through dl cannot alias it
-    detail::visitStencil(tid, cubed, [delta, nc, r](std::int64_t id, int n, double w3) {
-        double* dl = delta + (id*npt + n)*nc;
-        for (int c = 0; c < nc; ++c) dl[c] += w3*r[c];
-    });
+    switch (nc)
+    {
+        case 1: detail::scatterStencil<D, 1>(delta, tid, cubed, rr); break;
+        case 2: detail::scatterStencil<D, 2>(delta, tid, cubed, rr); break;
+        default: detail::scatterStencil<D, 3>(delta, tid, cubed, rr);
+    }
 }
 
 /// Morton code of a point's level-0 local coordinates on a 2^(63/D) grid
@@ -795,14 +794,11 @@ void flatStencil(const double* G, const indexBox<3>& b, const stencil<3>& st, do
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
     const double* p0 = G + (((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*n2 + (st.base[2] - b.lo[2]))*NC;
-    double row[4*NC] = {};
+    detail::vrow<4*NC> r = {};
     for (int a = 0; a < 4; ++a)
-        for (int c = 0; c < 4; ++c)
-        {
-            const double w = st.w[0][a]*st.w[1][c];
-            const double* p = p0 + (a*n1 + c)*n2*NC;
-            for (int j = 0; j < 4*NC; ++j) row[j] += w*p[j];
-        }
+        for (int c = 0; c < 4; ++c) detail::axpy<4*NC>(r, st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
+    double row[4*NC];
+    r.store(row);
     for (int c = 0; c < 4; ++c)
         for (int v = 0; v < NC; ++v) out[v] += st.w[2][c]*row[c*NC + v];
 }
@@ -812,12 +808,10 @@ void flatStencil(const double* G, const indexBox<2>& b, const stencil<2>& st, do
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
     const double* p0 = G + ((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*NC;
-    double row[4*NC] = {};
-    for (int a = 0; a < 4; ++a)
-    {
-        const double* p = p0 + a*n1*NC;
-        for (int j = 0; j < 4*NC; ++j) row[j] += st.w[0][a]*p[j];
-    }
+    detail::vrow<4*NC> r = {};
+    for (int a = 0; a < 4; ++a) detail::axpy<4*NC>(r, st.w[0][a], p0 + a*n1*NC);
+    double row[4*NC];
+    r.store(row);
     for (int c = 0; c < 4; ++c)
         for (int v = 0; v < NC; ++v) out[v] += st.w[1][c]*row[c*NC + v];
 }
@@ -901,26 +895,36 @@ void multilevel<D>::fold()
     flatBox_ = gb;
     flat_ = m;
 
-    // Which finer levels have tiles at each evaluation point (the same as
-    // long as the levels and flat_ are)
+    // Which finer levels have coefficients at each evaluation point (the
+    // same as long as the levels and flat_ are): levels whose lattice has a
+    // node with omega > 0 in the point's stencil. Where a level has no tile
+    // at the stencil, no finer level has one (their nodes lie within the
+    // stencils of the same control points).
     const std::pair<int, int> key(int(levels_.size()), flat_);
-    if (key == reachKey_) return;
-    reach_.assign(eval_.size, 0);
+    if (key == deepKey_) return;
+    precondition(int(levels_.size()) - flat_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
+    deepLevels_.assign(eval_.size, 0);
     deepTiles_.clear();
     stencilTiles<D> tid;
     for (std::size_t q = 0; q < eval_.size; ++q)
     {
         const point<D>& u0 = evalU0_[q];
-        int k = flat_ + 1;
-        for (; k < int(levels_.size()); ++k)
+        for (int k = flat_ + 1; k < int(levels_.size()); ++k)
         {
-            if (!findTiles(levels_[k]->view, stencil<D>(scaled<D>(u0, levels_[k]->scale).data()), tid)) break;
+            const level& L = *levels_[k];
+            const stencil<D> st(scaled<D>(u0, L.scale).data());
+            if (!findTiles(L.view, st, tid)) break;
+            bool any = false;
+            detail::visitStencil(tid, st, [&](std::int64_t id, int n, double) {
+                for (int c = 0; c < nw_; ++c) any = any || L.invOmega[(id*npt + n)*nw_ + c] > 0;
+            });
+            if (!any) continue;
+            deepLevels_[q] |= std::uint32_t(1) << (k - flat_ - 1);
             deepTiles_.push_back(tid);
         }
-        reach_[q] = std::uint8_t(k);
     }
     deepTiles_.shrink_to_fit();
-    reachKey_ = key;
+    deepKey_ = key;
 }
 
 template <int D>
@@ -960,13 +964,17 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
         const point<D>& u0 = evalU0_[q];
         double acc[3] = {0, 0, 0};
         flatStencil<D>(flatPhi_.data(), flatBox_, nc_, stencil<D>(scaled<D>(u0, sf).data()), acc);
-        const int top = std::min<int>(reach_[q], report_.levels);
-        for (int k = flat_ + 1; k < top; ++k)
+        int k = flat_ + 1;
+        for (std::uint32_t m = deepLevels_[q]; m; m >>= 1, ++k)
         {
-            const level& L = *levels_[k];
-            evalStencil(L.phi.data(), nc_, deep[k - flat_ - 1], stencil<D>(scaled<D>(u0, L.scale).data()), acc);
+            if (!(m & 1)) continue;
+            if (k < report_.levels)
+            {
+                const level& L = *levels_[k];
+                evalStencil(L.phi.data(), nc_, *deep, stencil<D>(scaled<D>(u0, L.scale).data()), acc);
+            }
+            ++deep;
         }
-        deep += std::max(0, reach_[q] - flat_ - 1);
         if (own)
         {
             double* o = &out[q*nc_];
@@ -1015,7 +1023,7 @@ template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
     std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + flatPhi_.capacity() + foldScratch_.capacity() + sweep_.capacity())*sizeof(double)
-        + active_.capacity() + mask_.capacity() + reach_.capacity() + deepTiles_.capacity()*sizeof(stencilTiles<D>)
+        + active_.capacity() + mask_.capacity() + deepLevels_.capacity()*sizeof(std::uint32_t) + deepTiles_.capacity()*sizeof(stencilTiles<D>)
         + (ctrlOrder_.capacity() + evalOrder_.capacity() + evalPos_.capacity())*sizeof(std::uint32_t)
         + (ctrlU0_.capacity() + evalU0_.capacity())*sizeof(point<D>) + stencils_.capacity()*sizeof(stencil<D>));
     for (const auto& L : levels_) b += L->stats.bytes;

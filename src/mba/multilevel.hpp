@@ -126,12 +126,13 @@ class multilevel
     point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
     indexBox<D> flatBox_;
     std::vector<double> flatPhi_, foldScratch_;
-    /// Per evaluation point, in evalOrder_: the first level above flat_ whose
-    /// lattice has no tile at its stencil (none finer has one either), for reachKey_
-    std::vector<std::uint8_t> reach_;
-    /// Their tiles at levels flat_ + 1 .. reach - 1, point after point in evalOrder_
+    /// Per evaluation point, in evalOrder_: the levels above flat_ with
+    /// coefficients at its stencil (a node with omega > 0; phi is 0 at the
+    /// others), bit j for level flat_ + 1 + j
+    std::vector<std::uint32_t> deepLevels_;
+    /// Their stencils' tiles, point after point in evalOrder_
     std::vector<stencilTiles<D>> deepTiles_;
-    std::pair<int, int> reachKey_{-1, -1}; ///< (levels built, flat_) reach_ was probed for
+    std::pair<int, int> deepKey_{-1, -1}; ///< (levels built, flat_) deepLevels_ was found for
     fitReport report_;
     std::int64_t nCtrlGlobal_ = 0;
 

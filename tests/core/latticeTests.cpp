@@ -1,0 +1,92 @@
+#include <catch2/catch.hpp>
+#include "lattice.hpp"
+
+#include <cmath>
+#include <random>
+
+using namespace mba;
+
+namespace {
+
+/// The stencil kernels (whole tile rows, split across tiles along the last
+/// direction) against a node-by-node reference, on a sparse layout with
+/// absent tiles, for stencils starting at every offset within a tile
+template <int D, int NC>
+void checkKernels(unsigned seed)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(-1, 1);
+    index<D> nodes;
+    nodes.fill(4*tileEdge);
+    tileLayout<D> L;
+    L.init(nodes, false);
+    indexBox<D> tiles;
+    tiles.lo.fill(0);
+    tiles.hi.fill(3);
+    forEachIndex<D>(tiles, [&](const index<D>& t) { if (U(rng) < 0.4) L.findOrInsert(t); });
+    std::vector<double> phi(L.size()*npt*NC);
+    for (double& x : phi) x = U(rng);
+
+    // Node-by-node: f(tile id, node in tile, weight) for the stencil's nodes in existing tiles
+    auto eachNode = [&](const stencil<D>& st, auto&& f) {
+        indexBox<D> a;
+        a.lo.fill(0);
+        a.hi.fill(3);
+        forEachIndex<D>(a, [&](const index<D>& i) {
+            index<D> t;
+            int n = 0;
+            double w = 1;
+            for (int d = 0; d < D; ++d)
+            {
+                const std::int64_t j = st.base[d] + i[d];
+                t[d] = j/tileEdge;
+                n = n*tileEdge + int(j % tileEdge);
+                w *= st.w[d][i[d]];
+            }
+            const std::int64_t id = L.find(t);
+            if (id >= 0) f(id, n, w);
+        });
+    };
+
+    int checked = 0;
+    for (int combo = 0; combo < (1 << (2*D)); ++combo)   // every offset in every direction
+        for (int rep = 0; rep < 4; ++rep)
+        {
+            point<D> u;
+            for (int d = 0; d < D; ++d)
+                u[d] = tileEdge*double(rng() % 3) + ((combo >> (2*d)) & 3) + 0.5*(U(rng) + 1);
+            const stencil<D> st(u.data());
+            stencilTiles<D> tid;
+            if (!findTiles(L, st, tid)) continue;
+            ++checked;
+
+            double ref[NC] = {}, got[NC] = {};
+            eachNode(st, [&](std::int64_t id, int n, double w) {
+                for (int k = 0; k < NC; ++k) ref[k] += w*phi[(id*npt + n)*NC + k];
+            });
+            evalStencil(phi.data(), NC, tid, st, got);
+            for (int k = 0; k < NC; ++k) REQUIRE_THAT(got[k], Catch::WithinAbs(ref[k], 1e-14));
+
+            double r[NC];
+            for (double& x : r) x = U(rng);
+            std::vector<double> a(phi.size(), 0.0), b(phi.size(), 0.0);
+            detail::scatterStencil<D, NC>(a.data(), tid, st, r);
+            eachNode(st, [&](std::int64_t id, int n, double w) {
+                for (int k = 0; k < NC; ++k) b[(id*npt + n)*NC + k] += w*r[k];
+            });
+            double diff = 0;
+            for (std::size_t j = 0; j < a.size(); ++j) diff = std::max(diff, std::abs(a[j] - b[j]));
+            REQUIRE(diff <= 1e-15);
+        }
+    REQUIRE(checked > (1 << (2*D)));
+}
+
+} // namespace
+
+TEST_CASE("tile-row stencil kernels equal a node-by-node reference", "[core][lattice]")
+{
+    const unsigned seed = GENERATE(1u, 2u, 3u);
+    SECTION("2D") { checkKernels<2, 1>(seed); checkKernels<2, 2>(seed); checkKernels<2, 3>(seed); }
+    SECTION("3D") { checkKernels<3, 1>(seed); checkKernels<3, 2>(seed); checkKernels<3, 3>(seed); }
+}
