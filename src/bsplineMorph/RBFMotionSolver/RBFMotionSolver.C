@@ -81,7 +81,8 @@ std::string Foam::RBFMotionSolver::interpolateD
 {
     const boundaryConstraints& bc = constraints();
     const labelList& dirs = bc.directions();
-    const mba::pointsView<D> eval(evalCoordinates(), std::size_t(points0().size()));
+    const labelList& points = evalPoints();
+    const mba::pointsView<D> eval(evalCoordinates(), std::size_t(points.size()));
     std::vector<double> values, out;
     label size = 0;
     scalar rcond = GREAT;
@@ -93,9 +94,9 @@ std::string Foam::RBFMotionSolver::interpolateD
             for (const label i : selected_[slot()][k]) values.push_back(bc.values()[i*D + k]);
             rbf[k]->fit(values);
             rbf[k]->evaluate(eval, out);
-            forAll(displacement, pointi)
+            forAll(points, i)
             {
-                displacement[pointi][dirs[k]] = out[pointi];
+                displacement[points[i]][dirs[k]] = out[i];
             }
             size = max(size, label(rbf[k]->stats().size));
             rcond = min(rcond, rbf[k]->stats().rcond);

@@ -55,9 +55,10 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 {
     // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
     // never sees an inverted cell): the divergence theorem over the faces,
-    // each face as its vertex mean and its area vector (the triangles about
-    // its first vertex), relative to one vertex of the cell. Exact for planar
-    // faces; one pass over the faces, no square roots, no face arrays.
+    // each face as its vertex mean and its area vector (twice it: for a quad
+    // the cross product of its diagonals, else the triangles about its first
+    // vertex), relative to one vertex of the cell. Exact for planar faces;
+    // one pass over the faces, no square roots, no face arrays.
     const faceList& faces = mesh().faces();
     const labelList& own = mesh().faceOwner();
     const labelList& nei = mesh().faceNeighbour();
@@ -75,19 +76,34 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
             if (cellRefPoint_[nei[facei]] < 0) cellRefPoint_[nei[facei]] = faces[facei][0];
         }
     }
-    scalarField vol(nCells, 0);
+    scalarField& vol = cellVol_;
+    vol.setSize(nCells);
+    vol = 0;
     forAll(faces, facei)
     {
         const face& f = faces[facei];
         const point& p0 = points[f[0]];
-        vector sum = p0, area = Zero;
-        for (label i = 1; i < f.size(); ++i)
+        vector sum, area;
+        if (f.size() == 4)
         {
-            const point& p = points[f[i]];
-            sum += p;
-            if (i + 1 < f.size())
+            const point& p1 = points[f[1]];
+            const point& p2 = points[f[2]];
+            const point& p3 = points[f[3]];
+            sum = p0 + p1 + p2 + p3;
+            area = (p2 - p0) ^ (p3 - p1);
+        }
+        else
+        {
+            sum = p0;
+            area = Zero;
+            for (label i = 1; i < f.size(); ++i)
             {
-                area += (p - p0) ^ (points[f[i + 1]] - p0);
+                const point& p = points[f[i]];
+                sum += p;
+                if (i + 1 < f.size())
+                {
+                    area += (p - p0) ^ (points[f[i + 1]] - p0);
+                }
             }
         }
         const point mean = sum/f.size();
@@ -111,23 +127,35 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 }
 
 
-const double* Foam::interpolatingMotionSolver::evalCoordinates() const
+void Foam::interpolatingMotionSolver::setEvalPoints()
 {
+    const boolList& fixed = constraintsPtr_->fixed();
+    label n = 0;
+    forAll(fixed, pointi)
+    {
+        if (!fixed[pointi]) ++n;
+    }
+    labelList points(n);
+    n = 0;
+    forAll(fixed, pointi)
+    {
+        if (!fixed[pointi]) points[n++] = pointi;
+    }
+    if (points == evalPoints_ && !evalXyz_.empty())
+    {
+        return;
+    }
+    evalPoints_.transfer(points);
     const labelList& dirs = constraintsPtr_->directions();
     const pointField& p0 = points0();
-    if (dirs.size() == 3)
+    evalXyz_.clear();
+    evalXyz_.reserve(dirs.size()*evalPoints_.size());
+    for (const label pointi : evalPoints_)
     {
-        return reinterpret_cast<const double*>(p0.cdata());
+        for (const label d : dirs) evalXyz_.push_back(p0[pointi][d]);
     }
-    if (evalXyz_.size() != std::size_t(dirs.size()*p0.size()))
-    {
-        evalXyz_.clear();
-        for (const point& p : p0)
-        {
-            for (const label d : dirs) evalXyz_.push_back(p[d]);
-        }
-    }
-    return evalXyz_.data();
+    // The re-fit plan evaluates these points too
+    planned_[1] = false;
 }
 
 
@@ -136,6 +164,10 @@ void Foam::interpolatingMotionSolver::use(const label slot, const bool changed)
     slot_ = slot;
     if (returnReduce(changed, orOp<bool>()) || !planned_[slot])
     {
+        if (slot == 0)
+        {
+            setEvalPoints();
+        }
         buildPlan();
         planned_[slot] = true;
     }
@@ -185,6 +217,10 @@ Foam::interpolatingMotionSolver::~interpolatingMotionSolver()
 Foam::tmp<Foam::pointField>
 Foam::interpolatingMotionSolver::curPoints() const
 {
+    if (newPoints_.size() == points0().size())
+    {
+        return tmp<pointField>(newPoints_);
+    }
     tmp<pointField> tcurPoints(points0() + pointDisplacement_.primitiveField());
     twoDCorrectPoints(tcurPoints.ref());
     return tcurPoints;
@@ -251,8 +287,13 @@ void Foam::interpolatingMotionSolver::solve()
     }
     constraintsPtr_->constrain(displacement);
 
-    newPoints_ = points0();
-    newPoints_ += displacement;
+    const pointField& p0 = points0();
+    newPoints_.setSize(p0.size());
+    forAll(newPoints_, pointi)
+    {
+        newPoints_[pointi] = p0[pointi] + displacement[pointi];
+    }
+    twoDCorrectPoints(newPoints_);
     const label nInverted = nInvertedCells(newPoints_);
     if (nInverted > 0)
     {
@@ -290,6 +331,7 @@ void Foam::interpolatingMotionSolver::solve()
 void Foam::interpolatingMotionSolver::movePoints(const pointField& p)
 {
     displacementMotionSolver::movePoints(p);
+    newPoints_.clear();
     clearPlan();
 }
 
@@ -301,7 +343,9 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     constraintsPtr_.reset();
     refitPtr_.reset();
     cellRefPoint_.clear();
+    evalPoints_.clear();
     evalXyz_.clear();
+    newPoints_.clear();
     clearPlan();
 }
 

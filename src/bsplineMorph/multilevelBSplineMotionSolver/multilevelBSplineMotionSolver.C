@@ -96,7 +96,7 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
     plan2.reset();
     try
     {
-        const std::size_t nEval = p0.size();
+        const std::size_t nEval = evalPoints().size();
         if (D == 3)
         {
             plan3.reset
@@ -136,7 +136,8 @@ void Foam::multilevelBSplineMotionSolver::buildPlan()
     }
     Info<< type() << ": " << (slot() ? "re-fit " : "") << "plan for "
         << bc.nControlGlobal() << " control points, "
-        << returnReduce(p0.size(), sumOp<label>()) << " mesh points, " << D << "D"
+        << returnReduce(p0.size(), sumOp<label>()) << " mesh points ("
+        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D"
         << endl;
 }
 
@@ -164,11 +165,13 @@ std::string Foam::multilevelBSplineMotionSolver::morph
         FatalErrorInFunction
             << "Multilevel B-spline fit failed: " << e.what() << exit(FatalError);
     }
-    forAll(displacement, pointi)
+    const labelList& points = evalPoints();
+    forAll(points, i)
     {
+        vector& d = displacement[points[i]];
         for (label k = 0; k < D; ++k)
         {
-            displacement[pointi][dirs[k]] = out[pointi*D + k];
+            d[dirs[k]] = out[i*D + k];
         }
     }
 
