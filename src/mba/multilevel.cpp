@@ -55,11 +55,12 @@ struct multilevel<D>::level
     tileLayout<D> own, view;
     bool ownIsView = false;         ///< serial, sparse: own tiles are the view (own left empty)
     std::vector<double> phi, invOmega; ///< view data: coefficients, 1/omega (0 where omega is)
-    std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< own tile ids / view tile ids per rank
-    std::vector<std::int64_t> ownToView; ///< empty when ownIsView
+    std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< view tile ids per rank (own ones / received ones)
+    /// Own tiles (view ids) that a lower rank also contributes to: this
+    /// rank's partial sums there are set aside and added in rank order
+    std::vector<std::int64_t> lowShared;
     /// The tiles of the control points' stencils (in ctrlOrder_) in the view
-    /// and, in parallel, in the own layout
-    std::vector<stencilTiles<D>> ctrlView, ctrlOwn;
+    std::vector<stencilTiles<D>> ctrlView;
     /// Ghosts: where a rank's control points near another rank's stencils cost
     /// less to send than the tiles they touch (fine levels), the owner sends
     /// their residuals and the receiver computes the owner's partial delta
@@ -73,7 +74,6 @@ struct multilevel<D>::level
     levelStats stats;
 
     const tileLayout<D>& ownTiles() const { return ownIsView ? view : own; }
-    std::int64_t toView(std::int64_t id) const { return ownIsView ? id : ownToView[id]; }
 };
 
 namespace {
@@ -447,10 +447,17 @@ void multilevel<D>::buildLevel(int k)
     else
     {
         L.view.init(nodes, dense);
-        L.ownToView.resize(nOwn);
-        for (std::int64_t id = 0; id < nOwn; ++id) L.ownToView[id] = L.view.findOrInsertKey(L.own.keyOf(id));
+        std::vector<std::int64_t> ownToView(nOwn);
+        for (std::int64_t id = 0; id < nOwn; ++id) ownToView[id] = L.view.findOrInsertKey(L.own.keyOf(id));
         for (int r = 0; r < P; ++r)
             for (auto key : keysGot[r]) L.recvTiles[r].push_back(L.view.findOrInsertKey(key));
+        for (auto& tiles : L.sendTiles)
+            for (auto& id : tiles) id = ownToView[id];
+        std::vector<std::uint8_t> shared(L.view.size(), 0);
+        for (std::int64_t id = 0; id < nOwn; ++id) shared[ownToView[id]] = 1;
+        for (int r = 0; r < me; ++r)
+            for (auto id : L.recvTiles[r])
+                if (shared[id] == 1) { shared[id] = 2; L.lowShared.push_back(id); }
 
         // omega: partial sums added in rank order
         L.invOmega.assign(L.view.size()*npt*nw_, 0.0);
@@ -459,7 +466,7 @@ void multilevel<D>::buildLevel(int k)
             if (r == me)
             {
                 for (std::int64_t id = 0; id < nOwn; ++id)
-                    for (int j = 0; j < npt*nw_; ++j) L.invOmega[L.ownToView[id]*npt*nw_ + j] += ownW[id*npt*nw_ + j];
+                    for (int j = 0; j < npt*nw_; ++j) L.invOmega[ownToView[id]*npt*nw_ + j] += ownW[id*npt*nw_ + j];
             }
             else
             {
@@ -495,7 +502,6 @@ void multilevel<D>::buildLevel(int k)
         L.ctrlView.resize(ctrlOrder_.size());
         pos = 0;
         forOwnStencils(L, [&](std::size_t, const stencil<D>& st) { findTiles(L.view, st, L.ctrlView[pos++]); });
-        if (P > 1) L.ctrlOwn = std::move(ownIds);
     }
 
     levelStats& s = L.stats;
@@ -506,8 +512,8 @@ void multilevel<D>::buildLevel(int k)
     s.dense = L.view.dense();
     s.nodes = L.view.size()*npt;
     s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
-        + L.own.bytes() + L.view.bytes() + L.ownToView.capacity()*sizeof(std::int64_t)
-        + (L.ctrlView.capacity() + L.ctrlOwn.capacity())*sizeof(stencilTiles<D>));
+        + L.own.bytes() + L.view.bytes() + L.lowShared.capacity()*sizeof(std::int64_t)
+        + L.ctrlView.capacity()*sizeof(stencilTiles<D>));
     for (int r = 0; r < P && P > 1; ++r)
     {
         s.tilesSent += std::int64_t(L.sendTiles[r].size());
@@ -534,24 +540,10 @@ void multilevel<D>::applyLevel(level& L)
 {
     constexpr int npt = level::npt;
     const int P = comm_.size(), me = comm_.rank();
-    const std::int64_t nOwn = L.ownTiles().size();
     const int blk = npt*nc_;
-    // Serial: delta accumulates straight into the view; parallel: into own
-    // partial sums, which are then added to the received ones in rank order
-    const bool direct = P == 1;
-    double* delta;
+    // delta += w^2 phi_c = w^3 r_c / sum(w^2): this rank's partial sums, in
+    // the view; in parallel the other ranks' are then added in rank order
     std::fill(L.phi.begin(), L.phi.end(), 0.0);
-    if (direct) delta = L.phi.data();
-    else
-    {
-        const std::size_t nd = std::size_t(nOwn)*blk;
-        if (scratch_.size() < nd) scratch_.resize(nd);
-        std::fill(scratch_.begin(), scratch_.begin() + nd, 0.0);
-        delta = scratch_.data();
-    }
-
-    // delta += w^2 phi_c = w^3 r_c / sum(w^2)
-    const std::vector<stencilTiles<D>>& tiles = direct ? L.ctrlView : L.ctrlOwn;
     std::size_t pos = 0;
     stencils_.resize(ctrlOrder_.size());
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
@@ -560,10 +552,10 @@ void multilevel<D>::applyLevel(level& L)
         double rr[3] = {0, 0, 0};
         for (int c = 0; c < nc_; ++c)
             rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        scatter<D>(delta, nc_, tiles[pos++], st, rr);
+        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr);
     });
 
-    if (!direct)
+    if (P > 1)
     {
         // Exchange the partial delta of the requested tiles, or the residuals
         // of the ghosts
@@ -577,7 +569,7 @@ void multilevel<D>::applyLevel(level& L)
                 continue;
             }
             send[r].reserve(L.sendTiles[r].size()*blk);
-            for (auto id : L.sendTiles[r]) send[r].insert(send[r].end(), delta + id*blk, delta + (id + 1)*blk);
+            for (auto id : L.sendTiles[r]) send[r].insert(send[r].end(), &L.phi[id*blk], &L.phi[(id + 1)*blk]);
         }
         std::vector<std::vector<double>> got = comm_.exchange(send);
 
@@ -599,27 +591,28 @@ void multilevel<D>::applyLevel(level& L)
             got[r].swap(dl);
         }
 
-        // sum over ranks, in rank order
+        // Sum over ranks, in rank order (every rank holding a node adds the
+        // same partial sums in the same order: bitwise the same delta). This
+        // rank's own sums are in place already; where a lower rank
+        // contributes too they are set aside and added at this rank's turn.
+        std::vector<double>& own = scratch_;
+        own.resize(L.lowShared.size()*blk);
+        for (std::size_t t = 0; t < L.lowShared.size(); ++t)
+        {
+            double* ph = &L.phi[L.lowShared[t]*blk];
+            std::copy(ph, ph + blk, &own[t*blk]);
+            std::fill(ph, ph + blk, 0.0);
+        }
+        auto add = [&](std::int64_t id, const double* dl) {
+            double* ph = &L.phi[id*blk];
+            for (int j = 0; j < blk; ++j) ph[j] += dl[j];
+        };
         for (int r = 0; r < P; ++r)
         {
             if (r == me)
-            {
-                for (std::int64_t id = 0; id < nOwn; ++id)
-                {
-                    double* ph = &L.phi[L.toView(id)*blk];
-                    const double* dl = delta + id*blk;
-                    for (int j = 0; j < blk; ++j) ph[j] += dl[j];
-                }
-            }
+                for (std::size_t t = 0; t < L.lowShared.size(); ++t) add(L.lowShared[t], &own[t*blk]);
             else
-            {
-                for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t)
-                {
-                    double* ph = &L.phi[L.recvTiles[r][t]*blk];
-                    const double* dl = &got[r][t*blk];
-                    for (int j = 0; j < blk; ++j) ph[j] += dl[j];
-                }
-            }
+                for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t) add(L.recvTiles[r][t], &got[r][t*blk]);
         }
     }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there too)
