@@ -23,9 +23,10 @@ Description
     Times the motion solver of constant/dynamicMeshDict step by step: the
     wall time of each motionSolver::newPoints() (the solve: boundary
     conditions, interpolation or equation, the new points), and nothing else
-    (the mesh is moved between steps, but not checked or written). A fair
-    per-step comparison of any motion solvers, displacementLaplacian
-    included, which logs no time of its own (benchmarks/run).
+    (the mesh is moved between steps and its points written at the
+    controlDict's write times, outside the timings, but not checked). A fair per-step comparison
+    of any motion solvers, displacementLaplacian included, which logs no
+    time of its own (benchmarks/run).
 
     Prints one line per step: "motionSolverTimes: step <time> <solve> s, mesh
     update <seconds> s" (the mesh update, fvMesh::movePoints, includes what
@@ -39,6 +40,7 @@ Usage
 #include "fvCFD.H"
 #include "motionSolver.H"
 #include "clockTime.H"
+#include "pointIOField.H"
 
 using namespace Foam;
 
@@ -78,6 +80,26 @@ int main(int argc, char* argv[])
         const scalar move = returnReduce(timer2.elapsedTime(), maxOp<scalar>());
         Info<< "motionSolverTimes: step " << runTime.timeName() << ' ' << solve << " s, mesh update "
             << move << " s" << endl;
+        if (runTime.writeTime())
+        {
+            // the moved points (the mesh itself is not a dynamic one that
+            // would write them)
+            pointIOField
+            (
+                IOobject
+                (
+                    "points",
+                    runTime.timeName(),
+                    polyMesh::meshSubDir,
+                    mesh,
+                    IOobject::NO_READ,
+                    IOobject::NO_WRITE,
+                    false
+                ),
+                mesh.points()
+            ).write();
+        }
+        runTime.write();
     }
 
     Info<< "End" << endl;
