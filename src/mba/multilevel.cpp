@@ -890,7 +890,7 @@ void multilevel<D>::fold()
 
     // Which finer levels have coefficients at each evaluation point (the
     // same as long as the levels and flat_ are): levels whose lattice has a
-    // node with omega > 0 in the point's stencil. Where a level has no tile
+    // node with omega > 0 and a non-zero weight in the point's stencil. Where a level has no tile
     // at the stencil, no finer level has one (their nodes lie within the
     // stencils of the same control points).
     const std::pair<int, int> key(int(levels_.size()), flat_);
@@ -907,11 +907,11 @@ void multilevel<D>::fold()
             const level& L = *levels_[k];
             const stencil<D> st(scaled<D>(u0, L.scale).data());
             if (!findTiles(L.view, st, tid)) break;
-            bool any = false;
-            detail::visitStencil(tid, st, [&](std::int64_t id, int n, double) {
-                for (int c = 0; c < nw_; ++c) any = any || L.invOmega[(id*npt + n)*nw_ + c] > 0;
-            });
-            if (!any) continue;
+            // (weights are >= 0: the weighted sum of 1/omega is > 0 exactly
+            // where a node of non-zero weight has coefficients)
+            double w[3] = {0, 0, 0};
+            evalStencil(L.invOmega.data(), nw_, tid, st, w);
+            if (!(w[0] + w[1] + w[2] > 0)) continue;
             deepLevels_[q] |= std::uint32_t(1) << (k - flat_ - 1);
             deepTiles_.push_back(tid);
         }
