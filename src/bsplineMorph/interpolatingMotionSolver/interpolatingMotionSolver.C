@@ -130,16 +130,10 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 void Foam::interpolatingMotionSolver::setEvalPoints()
 {
     const boolList& fixed = constraintsPtr_->fixed();
-    label n = 0;
+    DynamicList<label> points(fixed.size());
     forAll(fixed, pointi)
     {
-        if (!fixed[pointi]) ++n;
-    }
-    labelList points(n);
-    n = 0;
-    forAll(fixed, pointi)
-    {
-        if (!fixed[pointi]) points[n++] = pointi;
+        if (!fixed[pointi]) points.append(pointi);
     }
     if (points == evalPoints_ && !evalXyz_.empty())
     {
