@@ -176,13 +176,14 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     }
 
     const mba::fitReport& r = plan.report();
-    double nodes = 0, bytes = 0;
+    double nodes = 0, bytes = 0, messages = 0;
     for (const mba::levelStats& s : plan.stats())
     {
         if (s.level < r.levels)
         {
             nodes += s.nodes;
             bytes += s.bytesReceivedPerApply;
+            messages += s.messagesReceived;
             if (debug)
             {
                 Pout<< type() << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
@@ -195,12 +196,15 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     nodes = returnReduce(nodes, sumOp<scalar>());
     const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
     bytes = returnReduce(bytes, sumOp<scalar>());
+    const scalar messagesMax = returnReduce(messages, maxOp<scalar>());
+    messages = returnReduce(messages, sumOp<scalar>());
     const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
     OStringStream os;
     os  << r.levels << " levels, max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
-        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank), fit "
+        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
+        << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
         << r.seconds << " s, evaluation " << evalSeconds << " s";
     return os.str();
 }
