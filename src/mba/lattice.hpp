@@ -218,6 +218,17 @@ inline __attribute__((always_inline)) void axpy(vrow<N>& a, double w, const doub
     axpy<N>(a, w, vrow<N>::load(p));
 }
 
+/// Adds to out[0..NC) the row sum r (4 nodes of NC values along the last
+/// direction) weighted by the stencil's last-direction weights w
+template <int NC>
+inline __attribute__((always_inline)) void addRowSum(const vrow<4*NC>& r, const double* w, double* out)
+{
+    double s[4*NC];
+    r.store(s);
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) out[k] += w[c]*s[c*NC + k];
+}
+
 /// The rows of a stencil along its last direction: f(t, n, w) for each of
 /// its 4^(D-1) rows, with t the entry in stencilTiles of the tile that holds
 /// the row's first nodes (the next tile along the last direction is t + 1),
@@ -309,10 +320,7 @@ void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D
     forRows(st, [&](int t, int n, double w) {
         axpy<R>(acc, w, loadSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : zero));
     });
-    double s[R];
-    acc.store(s);
-    for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < NC; ++k) out[k] += st.w[D - 1][c]*s[c*NC + k];
+    addRowSum<NC>(acc, st.w[D - 1], out);
 }
 
 template <int D, int NC>

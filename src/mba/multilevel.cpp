@@ -790,10 +790,7 @@ void flatStencil(const double* G, const indexBox<3>& b, const stencil<3>& st, do
     detail::vrow<4*NC> r = {};
     for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 4; ++c) detail::axpy<4*NC>(r, st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
-    double row[4*NC];
-    r.store(row);
-    for (int c = 0; c < 4; ++c)
-        for (int v = 0; v < NC; ++v) out[v] += st.w[2][c]*row[c*NC + v];
+    detail::addRowSum<NC>(r, st.w[2], out);
 }
 
 template <int NC>
@@ -803,10 +800,7 @@ void flatStencil(const double* G, const indexBox<2>& b, const stencil<2>& st, do
     const double* p0 = G + ((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*NC;
     detail::vrow<4*NC> r = {};
     for (int a = 0; a < 4; ++a) detail::axpy<4*NC>(r, st.w[0][a], p0 + a*n1*NC);
-    double row[4*NC];
-    r.store(row);
-    for (int c = 0; c < 4; ++c)
-        for (int v = 0; v < NC; ++v) out[v] += st.w[1][c]*row[c*NC + v];
+    detail::addRowSum<NC>(r, st.w[1], out);
 }
 
 template <int D>
@@ -890,9 +884,9 @@ void multilevel<D>::fold()
 
     // Which finer levels have coefficients at each evaluation point (the
     // same as long as the levels and flat_ are): levels whose lattice has a
-    // node with omega > 0 and a non-zero weight in the point's stencil. Where a level has no tile
-    // at the stencil, no finer level has one (their nodes lie within the
-    // stencils of the same control points).
+    // node with omega > 0 and a non-zero weight in the point's stencil.
+    // Where a level has no tile at the stencil, no finer level has one
+    // (their nodes lie within the stencils of the same control points).
     const std::pair<int, int> key(int(levels_.size()), flat_);
     if (key == deepKey_) return;
     precondition(int(levels_.size()) - flat_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
