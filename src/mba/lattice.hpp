@@ -287,18 +287,32 @@ inline __attribute__((always_inline)) vrow<4*NC> loadSplit(const double* p0, con
     return r;
 }
 
-/// The same split row += w*a
-template <int NC, int OZ>
-inline __attribute__((always_inline)) void addSplit(double* p0, double* p1, double w, const vrow<4*NC>& a)
+/// How a scatter writes: adds, stores, or stores the selected components only
+enum class put { add, store, select };
+
+/// The same split row += w*a (store: = w*a; select: = w*a in the components
+/// whose flag in on[0..NC) is set)
+template <int NC, int OZ, put P>
+inline __attribute__((always_inline)) void addSplit(double* p0, double* p1, double w, const vrow<4*NC>& a,
+                                                    const bool* on)
 {
     constexpr int L = (4 - OZ)*NC;
     for (int i = 0; i < 2*NC; ++i)
     {
         const int j = 2*i;
         const v2d x = w*a.v[i];
-        if (j + 1 < L) *reinterpret_cast<v2du*>(p0 + OZ*NC + j) += x;
-        else if (j >= L) *reinterpret_cast<v2du*>(p1 + (j - L)) += x;
-        else { p0[OZ*NC + j] += x[0]; p1[0] += x[1]; }
+        // (v2du's alignment of 8 lives in its typedef: no auto& here)
+        v2du* q = reinterpret_cast<v2du*>(j + 1 < L ? p0 + OZ*NC + j : p1 + (j - L));
+        double* lo = j + 1 < L || j >= L ? reinterpret_cast<double*>(q) : p0 + OZ*NC + j;
+        double* hi = j + 1 < L || j >= L ? lo + 1 : p1;
+        if (P == put::select)
+        {
+            if (on[j % NC]) *lo = x[0];
+            if (on[(j + 1) % NC]) *hi = x[1];
+        }
+        else if (j + 1 < L || j >= L) { if (P == put::store) *q = x; else *q += x; }
+        else if (P == put::store) { *lo = x[0]; *hi = x[1]; }
+        else { *lo += x[0]; *hi += x[1]; }
     }
 }
 
@@ -337,9 +351,11 @@ void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D
 
 /// Adds w_n r (NC values) to each node n of the stencil, w_n the product of
 /// the stencil's weights (given cubed, for the fit's delta), row by row as the
-/// sweep reads them. Nodes in absent tiles (id < 0) are left out.
-template <int D, int NC, int OZ>
-void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r)
+/// sweep reads them (or stores it: put). Nodes in absent tiles (id < 0) are
+/// left out.
+template <int D, int NC, int OZ, put P>
+void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r,
+                    const bool* on)
 {
     constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
     double u[R], sink[R] = {};
@@ -351,19 +367,20 @@ void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>&
         return id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
     };
     forRows(st, [&](int t, int n, double w) {
-        addSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : sink, w, v);
+        addSplit<NC, OZ, P>(row(t, n), OZ ? row(t + 1, n) : sink, w, v, on);
     });
 }
 
-template <int D, int NC>
-void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r)
+template <int D, int NC, put P = put::add>
+void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r,
+                    const bool* on = nullptr)
 {
     switch (st.base[D - 1] & 3)
     {
-        case 0: scatterStencil<D, NC, 0>(delta, tid, st, r); break;
-        case 1: scatterStencil<D, NC, 1>(delta, tid, st, r); break;
-        case 2: scatterStencil<D, NC, 2>(delta, tid, st, r); break;
-        default: scatterStencil<D, NC, 3>(delta, tid, st, r);
+        case 0: scatterStencil<D, NC, 0, P>(delta, tid, st, r, on); break;
+        case 1: scatterStencil<D, NC, 1, P>(delta, tid, st, r, on); break;
+        case 2: scatterStencil<D, NC, 2, P>(delta, tid, st, r, on); break;
+        default: scatterStencil<D, NC, 3, P>(delta, tid, st, r, on);
     }
 }
 } // namespace detail

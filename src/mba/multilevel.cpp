@@ -54,6 +54,20 @@ struct multilevel<D>::level
     double scale = 1;               ///< 2^k: u_k = u_0*scale
     tileLayout<D> own, view;
     bool ownIsView = false;         ///< serial, sparse: own tiles are the view (own left empty)
+    /// No two control points (of any rank) share a node of their stencils
+    /// (fine levels, where the points are farther apart than a stencil): a
+    /// point's nodes then take phi = w r/sum(w^2) from it alone, and its
+    /// residual after the level is r - (r/sum(w^2)) sum(w^2), 0 but for
+    /// rounding. Per fit the lattice is neither cleared (but for the tiles
+    /// other ranks' sums arrive in) nor scaled by 1/omega nor swept, and phi
+    /// is stored only at the points whose tiles are read in every fit
+    /// (readEveryFit: by this rank's evaluation stencils, by other ranks,
+    /// or for the flat lattice); the others' phi is stored from rr when
+    /// evaluateControl or evaluate(x) asks for the whole lattice (complete).
+    bool separated = false;
+    std::vector<std::uint8_t> readEveryFit; ///< per own point in ctrlOrder_
+    std::vector<double> rr;                 ///< per own point x component: r/sum(w^2) of the last fit
+    bool complete = true;                   ///< every point's phi stored since the last fit
     std::vector<double> phi, invOmega; ///< view data: coefficients, 1/omega (0 where omega is)
     std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< view tile ids per rank (own ones / received ones)
     /// Own tiles (view ids) that a lower rank also contributes to: this
@@ -82,9 +96,28 @@ namespace {
 /// of its stencil (rr = r/sum(w^2) per component), w^3 as the product of the
 /// directions' cubed weights. The point's owner and a rank holding it as a
 /// ghost both add it through here: bitwise the same sums.
+/// separated: the point is the only one at its nodes in the components it
+/// constrains (level::separated; on: those components, nullptr: all), so
+/// phi = delta/omega = w r/sum(w^2) there: that is stored, not added, and
+/// only in those components.
 template <int D>
-inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
+inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr,
+                    bool separated, const bool* on)
 {
+    if (separated)
+    {
+        using detail::put;
+        switch (nc * (on ? -1 : 1))
+        {
+            case 1: detail::scatterStencil<D, 1, put::store>(delta, tid, st, rr); break;
+            case 2: detail::scatterStencil<D, 2, put::store>(delta, tid, st, rr); break;
+            case 3: detail::scatterStencil<D, 3, put::store>(delta, tid, st, rr); break;
+            case -1: detail::scatterStencil<D, 1, put::select>(delta, tid, st, rr, on); break;
+            case -2: detail::scatterStencil<D, 2, put::select>(delta, tid, st, rr, on); break;
+            default: detail::scatterStencil<D, 3, put::select>(delta, tid, st, rr, on);
+        }
+        return;
+    }
     stencil<D> cubed = st;
     for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
     switch (nc)
@@ -476,6 +509,28 @@ void multilevel<D>::buildLevel(int k)
             }
         }
     }
+    if (L.ownIsView) L.ctrlView = std::move(ownIds);
+    else
+    {
+        L.ctrlView.resize(ctrlOrder_.size());
+        pos = 0;
+        forOwnStencils(L, [&](std::size_t, const stencil<D>& st) { findTiles(L.view, st, L.ctrlView[pos++]); });
+    }
+
+    // Separated: at every node of every own stencil, in every component the
+    // point constrains, omega (the sum over all ranks) is this point's own
+    // w^2 alone, summed as the plan summed it (0 + w*w: exact), also at nodes
+    // where its weight is 0
+    bool alone = true;
+    pos = 0;
+    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+        detail::visitStencil(L.ctrlView[pos++], st, [&](std::int64_t id, int n, double w) {
+            const double* o = &L.invOmega[(id*npt + n)*nw_];
+            for (int c = 0; c < nw_; ++c)
+                if (nw_ == 1 || mask_[i*nc_ + c]) alone = alone && o[c] == w*w;
+        });
+    });
+    L.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
     for (double& o : L.invOmega) o = o > 0 ? 1/o : 0.0;
 
     // The ghosts' stencil tiles, numbered as the tiles received from their rank
@@ -496,12 +551,23 @@ void multilevel<D>::buildLevel(int k)
     }
     L.phi.assign(L.view.size()*npt*nc_, 0.0);
     precondition(L.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
-    if (L.ownIsView) L.ctrlView = std::move(ownIds);
-    else
+    if (L.separated)
     {
-        L.ctrlView.resize(ctrlOrder_.size());
-        pos = 0;
-        forOwnStencils(L, [&](std::size_t, const stencil<D>& st) { findTiles(L.view, st, L.ctrlView[pos++]); });
+        // Tiles read in every fit: all when the level may be folded into the
+        // flat lattice; else those sent as tiles and those that this rank's
+        // evaluation stencils touch
+        std::vector<std::uint8_t> read(L.view.size(), flattens(k) ? 1 : 0);
+        for (int r = 0; r < P && P > 1; ++r)
+            if (L.ghostSend[r].empty())
+                for (const std::int64_t id : L.sendTiles[r]) read[id] = 1;
+        stencilTiles<D> tid;
+        for (const point<D>& u0 : evalU0_)
+            if (findTiles(L.view, stencil<D>(scaled<D>(u0, L.scale).data()), tid))
+                for (const std::int32_t id : tid) if (id >= 0) read[id] = 1;
+        L.readEveryFit.assign(ctrlOrder_.size(), 0);
+        for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+            for (const std::int32_t id : L.ctrlView[q]) if (id >= 0 && read[id]) L.readEveryFit[q] = 1;
+        L.rr.assign(ctrlOrder_.size()*nc_, 0.0);
     }
 
     levelStats& s = L.stats;
@@ -510,10 +576,11 @@ void multilevel<D>::buildLevel(int k)
     s.ownTiles = L.ownTiles().size();
     s.viewTiles = L.view.size();
     s.dense = L.view.dense();
+    s.separated = L.separated;
     s.nodes = L.view.size()*npt;
     s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
         + L.own.bytes() + L.view.bytes() + L.lowShared.capacity()*sizeof(std::int64_t)
-        + L.ctrlView.capacity()*sizeof(stencilTiles<D>));
+        + L.ctrlView.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity() + L.rr.capacity()*sizeof(double));
     for (int r = 0; r < P && P > 1; ++r)
     {
         s.tilesSent += std::int64_t(L.sendTiles[r].size());
@@ -542,8 +609,14 @@ void multilevel<D>::applyLevel(level& L)
     const int P = comm_.size(), me = comm_.rank();
     const int blk = npt*nc_;
     // delta += w^2 phi_c = w^3 r_c / sum(w^2): this rank's partial sums, in
-    // the view; in parallel the other ranks' are then added in rank order
-    std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    // the view; in parallel the other ranks' are then added in rank order.
+    // Separated: phi itself is stored at the own points' nodes, which are the
+    // same in every fit (the other nodes stay 0), and only the tiles that
+    // other ranks' values are added to are cleared.
+    if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    else
+        for (const auto& tiles : L.recvTiles)
+            for (const std::int64_t id : tiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);
     std::size_t pos = 0;
     stencils_.resize(ctrlOrder_.size());
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
@@ -552,8 +625,15 @@ void multilevel<D>::applyLevel(level& L)
         double rr[3] = {0, 0, 0};
         for (int c = 0; c < nc_; ++c)
             rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr);
+        if (L.separated)
+        {
+            std::copy(rr, rr + nc_, &L.rr[pos*nc_]);
+            if (!L.readEveryFit[pos]) { ++pos; return; }
+        }
+        bool on[3];
+        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr, L.separated, constrained(i, on));
     });
+    L.complete = !L.separated;
 
     if (P > 1)
     {
@@ -585,8 +665,13 @@ void multilevel<D>::applyLevel(level& L)
                 const stencil<D> st(scaled<D>(dom_.local0(x), L.scale).data());
                 const double sw = st.sumSquares();
                 double rr[3] = {0, 0, 0};
-                for (int c = 0; c < nc_; ++c) rr[c] = x[D + c] != 0 ? got[r][g*nc_ + c]/sw : 0.0;
-                scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr);     // as the owner does
+                bool on[3];
+                for (int c = 0; c < nc_; ++c)
+                {
+                    on[c] = x[D + c] != 0;
+                    rr[c] = on[c] ? got[r][g*nc_ + c]/sw : 0.0;
+                }
+                scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr, L.separated, nw_ == 1 ? nullptr : on); // as the owner does
             }
             got[r].swap(dl);
         }
@@ -615,19 +700,30 @@ void multilevel<D>::applyLevel(level& L)
                 for (std::size_t t = 0; t < L.recvTiles[r].size(); ++t) add(L.recvTiles[r][t], &got[r][t*blk]);
         }
     }
-    // phi = delta/omega (no contribution where omega is 0: delta is 0 there too)
-    if (nw_ == 1)
+    // phi = delta/omega (no contribution where omega is 0: delta is 0 there
+    // too); separated levels hold phi already
+    if (!L.separated && nw_ == 1)
     {
         const std::size_t nNodes = L.invOmega.size();
         for (std::size_t n = 0; n < nNodes; ++n)
             for (int c = 0; c < nc_; ++c) L.phi[n*nc_ + c] *= L.invOmega[n];
     }
-    else
+    else if (!L.separated)
     {
         for (std::size_t j = 0; j < L.phi.size(); ++j) L.phi[j] *= L.invOmega[j];
     }
 
     // Residuals at this rank's control points
+    if (L.separated)
+    {
+        for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+        {
+            const std::size_t i = ctrlOrder_[q];
+            const double sw = stencils_[q].sumSquares();
+            for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= L.rr[q*nc_ + c]*sw;
+        }
+        return;
+    }
     for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
     {
         const std::size_t i = ctrlOrder_[q];
@@ -830,15 +926,39 @@ indexBox<D> multilevel<D>::evalNodeBox(int k) const
 }
 
 template <int D>
+bool multilevel<D>::flattens(int k) const
+{
+    return eval_.size > 0 && boxNodes<D>(evalNodeBox(k)) <= double(std::max<std::size_t>(eval_.size, 4096));
+}
+
+template <int D>
+void multilevel<D>::completeLattices() const
+{
+    for (const auto& Lp : levels_)
+    {
+        // (phi of a separated level's points that no planned reader needs:
+        // stored on demand, the lattice's value does not change)
+        level& L = *Lp;
+        if (L.complete) continue;
+        std::size_t pos = 0;
+        forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
+            bool on[3];
+            if (!L.readEveryFit[pos])
+                scatter<D>(L.phi.data(), nc_, L.ctrlView[pos], st, &L.rr[pos*nc_], true, constrained(i, on));
+            ++pos;
+        });
+        L.complete = true;
+    }
+}
+
+template <int D>
 void multilevel<D>::fold()
 {
     constexpr int npt = level::npt;
     flat_ = -1;
     flatPhi_.clear();
-    if (eval_.size == 0) return;
-    const double budget = double(std::max<std::size_t>(eval_.size, 4096));
     int m = -1;
-    while (m + 1 < report_.levels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
+    while (m + 1 < report_.levels && flattens(m + 1)) ++m;
     if (m < 0) return;
     // flatPhi_ and foldScratch_ keep their storage from fit to fit
     std::vector<double>& G = flatPhi_;
@@ -987,6 +1107,7 @@ void multilevel<D>::evaluate(const double* x, double* out) const
 {
     if (comm_.size() != 1)
         throw std::logic_error("mba: evaluation at unplanned points needs the serial communicator");
+    completeLattices();
     for (int c = 0; c < nc_; ++c) out[c] = 0;
     addLevels(x, out, report_.levels);
 }
@@ -994,6 +1115,7 @@ void multilevel<D>::evaluate(const double* x, double* out) const
 template <int D>
 void multilevel<D>::evaluateControl(std::vector<double>& out) const
 {
+    completeLattices();
     out.assign(ctrl_.size*nc_, 0.0);
     for (std::size_t i = 0; i < ctrl_.size; ++i) addLevels(ctrl_[i], &out[i*nc_], report_.levels);
 }

@@ -68,6 +68,7 @@ struct levelStats
     std::int64_t ownTiles = 0;            ///< tiles holding this rank's partial sums
     std::int64_t viewTiles = 0;           ///< tiles of the rank's view (own + received)
     bool dense = false;                   ///< view stored densely
+    bool separated = false;               ///< no two control points share a node (phi stored directly)
     std::int64_t nodes = 0;               ///< node slots stored in the view
     std::int64_t bytes = 0;               ///< bytes of the level (view data, layouts)
     std::int64_t buckets = 0;             ///< this rank's buckets
@@ -143,6 +144,18 @@ class multilevel
     void addLevels(const double* x, double* out, int nLevels) const;
     void fold();
     indexBox<D> evalNodeBox(int k) const;
+    /// Level k may be folded into the flat lattice (its evaluation node box is small enough)
+    bool flattens(int k) const;
+    /// Stores the coefficients that separated levels leave out per fit (level::readEveryFit)
+    void completeLattices() const;
+    /// The components control point i constrains, in on[0..nc): on, or
+    /// nullptr when every active point constrains all (one omega per node)
+    const bool* constrained(std::size_t i, bool* on) const
+    {
+        if (nw_ == 1) return nullptr;
+        for (int c = 0; c < nc_; ++c) on[c] = mask_[i*nc_ + c] != 0;
+        return on;
+    }
 
 public:
     /// The plan. control, evaluation: this rank's points (not copied: they must

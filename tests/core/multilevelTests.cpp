@@ -178,6 +178,85 @@ TEST_CASE("planned evaluation (flat lattice + finer levels) equals the sum of th
     flatEqualsLevels<3>();
 }
 
+namespace {
+
+/// The plan fitted to v1 and then, through the plan, to v2 equals the plain
+/// method at the evaluation points and at the control points; returns the
+/// plan's level statistics
+template <int D>
+std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std::vector<std::uint8_t>& mask,
+                                       const std::vector<point<D>>& e)
+{
+    params p;
+    p.affine = false;
+    p.tolerance = 1e-13;
+    p.maxLevels = 14;
+    multilevel<D> m(serial, p, 3, c, mask, e);
+    std::vector<double> v1 = smoothValues<D>(c, 3), v2 = v1;
+    for (double& x : v2) x = 0.4*x*x - x;
+    m.fit(v1);
+    const fitReport& r = m.fit(v2);
+    CHECK(r.converged);
+    const double tol = 1e-12*maxAbs(v2);
+    std::vector<double> got;
+    m.evaluate(got);
+    const std::vector<double> ref = plainMBA<D>(m.dom(), r.levels, 3, c, v2, mask, e);
+    REQUIRE(got.size() == ref.size());
+    for (std::size_t i = 0; i < got.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(ref[i], tol));
+    m.evaluateControl(got);
+    const std::vector<double> refc = plainMBA<D>(m.dom(), r.levels, 3, c, v2, mask, c);
+    for (std::size_t i = 0; i < got.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(refc[i], tol));
+    auto st = m.stats();
+    st.resize(r.levels);
+    return st;
+}
+
+template <int D>
+void separatedLevels(bool masked)
+{
+    // two faces of a mesh; evaluation points in the volume and next to the
+    // control points (their stencils read the separated level)
+    std::vector<point<D>> c = twoFaces<D>(D == 3 ? 9 : 17, 0.1, 51);
+    std::vector<point<D>> e = randomPoints<D>(400, 52);
+    for (std::size_t i = 0; i < c.size(); i += 3)
+    {
+        point<D> x = c[i];
+        x[D - 1] = x[D - 1] > 0.5 ? x[D - 1] - 0.004 : x[D - 1] + 0.004;
+        e.push_back(x);
+    }
+    std::vector<std::uint8_t> mask;
+    if (masked)
+    {
+        mask.assign(c.size()*3, 1);
+        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*3 + i % 3] = 0;
+    }
+    INFO("D " << D << ", masked " << masked);
+    const std::vector<levelStats> st = equalsPlainMBA<D>(c, mask, e);
+    // the last level separates the points (that is why the residual is
+    // then 0), the coarse ones do not
+    REQUIRE(st.size() >= 4);
+    CHECK(st.back().separated);
+    CHECK_FALSE(st[st.size() - 3].separated);
+
+    // one more point half a cell of that level from another: not separated
+    point<D> x = c[c.size()/2];
+    x[0] += 0.5*st.back().h;
+    c.push_back(x);
+    if (masked) mask.insert(mask.end(), {1, 1, 1});
+    const std::vector<levelStats> close = equalsPlainMBA<D>(c, mask, e);
+    REQUIRE(close.size() >= st.size());
+    CHECK_FALSE(close[st.size() - 1].separated);
+}
+
+} // namespace
+
+TEST_CASE("levels that separate the control points equal the plain method", "[core]")
+{
+    const bool masked = GENERATE(false, true);
+    separatedLevels<2>(masked);
+    separatedLevels<3>(masked);
+}
+
 TEST_CASE("applying new values through the plan equals a fresh fit", "[core]")
 {
     const auto c = randomPoints<3>(2000, 31);

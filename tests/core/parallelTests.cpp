@@ -118,6 +118,49 @@ TEST_CASE("serial equals simulated ranks", "[parallel]")
     serialEqualsRanks<3>(affine, masked, how);
 }
 
+TEST_CASE("levels that separate the control points: serial equals simulated ranks", "[parallel]")
+{
+    // two faces of a mesh, evaluation points in the volume and next to the
+    // faces (their stencils read the separated level, also across ranks)
+    const bool masked = GENERATE(false, true);
+    const partition how = GENERATE(partition::slabs, partition::random);
+    const std::vector<point<3>> c = twoFaces<3>(13, 0.1, 61);
+    std::vector<point<3>> e = randomPoints<3>(600, 62);
+    for (std::size_t i = 0; i < c.size(); i += 2)
+    {
+        point<3> x = c[i];
+        x[2] = x[2] > 0.5 ? x[2] - 0.003 : x[2] + 0.003;
+        e.push_back(x);
+    }
+    problem pb;
+    pb.p.tolerance = 1e-12;
+    pb.p.bucketTiles = 8;
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    std::vector<std::uint8_t> mask;
+    if (masked)
+    {
+        mask.assign(c.size()*pb.nc, 1);
+        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*pb.nc + i % 3] = 0;
+    }
+    {
+        // (the finest level used does separate them)
+        multilevel<3> m(serialCommunicator(), pb.p, pb.nc, c, mask, e);
+        std::vector<double> vm = v;
+        const fitReport& r = m.fit(vm);
+        REQUIRE(r.converged);
+        REQUIRE(m.stats()[r.levels - 1].separated);
+    }
+    const std::vector<double> ref = solve<3>(1, how, c, v, mask, e, pb);
+    for (int P : {2, 3, 5})
+    {
+        INFO("ranks " << P << ", masked " << masked << ", partition " << (how == partition::slabs ? "slabs" : "random"));
+        const std::vector<double> got = solve<3>(P, how, c, v, mask, e, pb);
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+        CHECK(diff <= 1e-12*maxAbs(v));
+    }
+}
+
 TEST_CASE("ranks without control or evaluation points", "[parallel]")
 {
     // all control points on rank 0, all evaluation points on the last rank

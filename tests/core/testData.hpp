@@ -5,6 +5,7 @@
 #include "multilevel.hpp"
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -61,6 +62,78 @@ inline double maxAbs(const std::vector<double>& v)
     double m = 0;
     for (double x : v) m = std::max(m, std::abs(x));
     return m;
+}
+
+/// A k^(D-1) grid on each of the two faces x_(D-1) = 0 and 1 of the unit
+/// cube (square), each point moved by up to jitter of the spacing (seeded):
+/// a mesh's top and bottom, whose finest levels are separated
+template <int D>
+std::vector<mba::point<D>> twoFaces(int k, double jitter, unsigned seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(-jitter/(k - 1), jitter/(k - 1));
+    std::vector<mba::point<D>> p;
+    for (int side = 0; side < 2; ++side)
+        for (long i = 0; i < (D == 3 ? long(k)*k : k); ++i)
+        {
+            mba::point<D> x;
+            x[0] = double(i % k)/(k - 1) + U(rng);
+            if (D == 3) x[1] = double(i / k)/(k - 1) + U(rng);
+            x[D - 1] = side;
+            p.push_back(x);
+        }
+    return p;
+}
+
+/// The method written out plainly, as an oracle: the paper's Eq. 5-6 level
+/// after level, each level's lattice a std::map of the nodes the control
+/// points' stencils touch, omega per component over the points that
+/// constrain it (mask, point x component; empty: all). Returns the sum of
+/// the first `levels` levels at the points e (no affine start).
+template <int D>
+std::vector<double> plainMBA(const mba::domain<D>& dom, int levels, int nc, const std::vector<mba::point<D>>& c,
+                             std::vector<double> r, const std::vector<std::uint8_t>& mask,
+                             const std::vector<mba::point<D>>& e)
+{
+    using node = std::array<std::int64_t, D>;
+    auto forNodes = [&](const mba::point<D>& x, int k, auto&& f) {
+        mba::point<D> u = dom.local0(x.data());
+        for (double& t : u) t *= std::ldexp(1.0, k);
+        const mba::stencil<D> st(u.data());
+        for (int a = 0; a < (1 << 2*D); ++a)
+        {
+            node n;
+            double w = 1;
+            for (int d = 0; d < D; ++d) { const int o = (a >> 2*d) & 3; n[d] = st.base[d] + o; w *= st.w[d][o]; }
+            f(n, w, st.sumSquares());
+        }
+    };
+    auto on = [&](std::size_t i, int q) { return mask.empty() || mask[i*nc + q]; };
+    std::vector<double> out(e.size()*nc, 0.0), fc(c.size()*nc);
+    for (int k = 0; k < levels; ++k)
+    {
+        std::map<node, std::vector<double>> lattice;   // delta, then omega, per component
+        for (std::size_t i = 0; i < c.size(); ++i)
+            forNodes(c[i], k, [&](const node& n, double w, double S) {
+                std::vector<double>& dw = lattice[n];
+                dw.resize(2*nc, 0.0);
+                for (int q = 0; q < nc; ++q)
+                    if (on(i, q)) { dw[q] += w*w*(w*r[i*nc + q]/S); dw[nc + q] += w*w; }
+            });
+        auto add = [&](const mba::point<D>& x, double* acc) {
+            forNodes(x, k, [&](const node& n, double w, double) {
+                const auto it = lattice.find(n);
+                if (it == lattice.end()) return;
+                for (int q = 0; q < nc; ++q)
+                    if (it->second[nc + q] > 0) acc[q] += w*it->second[q]/it->second[nc + q];
+            });
+        };
+        std::fill(fc.begin(), fc.end(), 0.0);
+        for (std::size_t i = 0; i < c.size(); ++i) add(c[i], &fc[i*nc]);
+        for (std::size_t i = 0; i < r.size(); ++i) r[i] -= fc[i];
+        for (std::size_t j = 0; j < e.size(); ++j) add(e[j], &out[j*nc]);
+    }
+    return out;
 }
 
 } // namespace bsmTest

@@ -177,10 +177,12 @@ std::string Foam::multilevelBSplineMotionSolver::morph
 
     const mba::fitReport& r = plan.report();
     double nodes = 0, bytes = 0, messages = 0;
+    label separated = 0;
     for (const mba::levelStats& s : plan.stats())
     {
         if (s.level < r.levels)
         {
+            separated += s.separated;
             nodes += s.nodes;
             bytes += s.bytesReceivedPerApply;
             messages += s.messagesReceived;
@@ -188,7 +190,8 @@ std::string Foam::multilevelBSplineMotionSolver::morph
             {
                 Pout<< type() << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
                     << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
-                    << (s.dense ? " dense" : " sparse") << " received " << s.bytesReceivedPerApply
+                    << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
+                    << " received " << s.bytesReceivedPerApply
                     << " B, max residual " << s.maxResidual << ", " << s.seconds << " s" << endl;
             }
         }
@@ -200,7 +203,7 @@ std::string Foam::multilevelBSplineMotionSolver::morph
     messages = returnReduce(messages, sumOp<scalar>());
     const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
     OStringStream os;
-    os  << r.levels << " levels, max residual " << r.maxResidual
+    os  << r.levels << " levels (" << separated << " separated), max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
