@@ -296,8 +296,13 @@ template <int D>
 template <class F>
 void multilevel<D>::forOwnStencils(const level& L, F&& f) const
 {
-    for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
-        f(std::size_t(ctrlOrder_[q]), stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data()));
+    for (std::size_t q = 0; q < ctrlOrder_.size(); ++q) f(std::size_t(ctrlOrder_[q]), ctrlStencil(L, q));
+}
+
+template <int D>
+stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q) const
+{
+    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data());
 }
 
 template <int D>
@@ -521,15 +526,17 @@ void multilevel<D>::buildLevel(int k)
     // point constrains, omega (the sum over all ranks) is this point's own
     // w^2 alone, summed as the plan summed it (0 + w*w: exact), also at nodes
     // where its weight is 0
+    // (a coarse level fails at its first points)
     bool alone = true;
-    pos = 0;
-    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
-        detail::visitStencil(L.ctrlView[pos++], st, [&](std::int64_t id, int n, double w) {
+    for (std::size_t q = 0; q < ctrlOrder_.size() && alone; ++q)
+    {
+        const std::size_t i = ctrlOrder_[q];
+        detail::visitStencil(L.ctrlView[q], ctrlStencil(L, q), [&](std::int64_t id, int n, double w) {
             const double* o = &L.invOmega[(id*npt + n)*nw_];
             for (int c = 0; c < nw_; ++c)
                 if (nw_ == 1 || mask_[i*nc_ + c]) alone = alone && o[c] == w*w;
         });
-    });
+    }
     L.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
     for (double& o : L.invOmega) o = o > 0 ? 1/o : 0.0;
 
@@ -553,20 +560,8 @@ void multilevel<D>::buildLevel(int k)
     precondition(L.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L.separated)
     {
-        // Tiles read in every fit: all when the level may be folded into the
-        // flat lattice; else those sent as tiles and those that this rank's
-        // evaluation stencils touch
-        std::vector<std::uint8_t> read(L.view.size(), flattens(k) ? 1 : 0);
-        for (int r = 0; r < P && P > 1; ++r)
-            if (L.ghostSend[r].empty())
-                for (const std::int64_t id : L.sendTiles[r]) read[id] = 1;
-        stencilTiles<D> tid;
-        for (const point<D>& u0 : evalU0_)
-            if (findTiles(L.view, stencil<D>(scaled<D>(u0, L.scale).data()), tid))
-                for (const std::int32_t id : tid) if (id >= 0) read[id] = 1;
-        L.readEveryFit.assign(ctrlOrder_.size(), 0);
-        for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
-            for (const std::int32_t id : L.ctrlView[q]) if (id >= 0 && read[id]) L.readEveryFit[q] = 1;
+        // every point's phi is stored until fold() has found the tiles read
+        L.readEveryFit.assign(ctrlOrder_.size(), 1);
         L.rr.assign(ctrlOrder_.size()*nc_, 0.0);
     }
 
@@ -926,12 +921,6 @@ indexBox<D> multilevel<D>::evalNodeBox(int k) const
 }
 
 template <int D>
-bool multilevel<D>::flattens(int k) const
-{
-    return eval_.size > 0 && boxNodes<D>(evalNodeBox(k)) <= double(std::max<std::size_t>(eval_.size, 4096));
-}
-
-template <int D>
 void multilevel<D>::completeLattices() const
 {
     for (const auto& Lp : levels_)
@@ -957,8 +946,10 @@ void multilevel<D>::fold()
     constexpr int npt = level::npt;
     flat_ = -1;
     flatPhi_.clear();
+    if (eval_.size == 0) return;
+    const double budget = double(std::max<std::size_t>(eval_.size, 4096));
     int m = -1;
-    while (m + 1 < report_.levels && flattens(m + 1)) ++m;
+    while (m + 1 < report_.levels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
     if (m < 0) return;
     // flatPhi_ and foldScratch_ keep their storage from fit to fit
     std::vector<double>& G = flatPhi_;
@@ -1007,11 +998,15 @@ void multilevel<D>::fold()
     // node with omega > 0 and a non-zero weight in the point's stencil.
     // Where a level has no tile at the stencil, no finer level has one
     // (their nodes lie within the stencils of the same control points).
+    // For separated levels this also finds the tiles that evaluation reads.
     const std::pair<int, int> key(int(levels_.size()), flat_);
     if (key == deepKey_) return;
     precondition(int(levels_.size()) - flat_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
     deepLevels_.assign(eval_.size, 0);
     deepTiles_.clear();
+    std::vector<std::vector<std::uint8_t>> read(levels_.size());
+    for (int k = flat_ + 1; k < int(levels_.size()); ++k)
+        if (levels_[k]->separated) read[k].assign(levels_[k]->view.size(), 0);
     stencilTiles<D> tid;
     for (std::size_t q = 0; q < eval_.size; ++q)
     {
@@ -1028,10 +1023,33 @@ void multilevel<D>::fold()
             if (!(w[0] + w[1] + w[2] > 0)) continue;
             deepLevels_[q] |= std::uint32_t(1) << (k - flat_ - 1);
             deepTiles_.push_back(tid);
+            if (!read[k].empty()) for (const std::int32_t id : tid) if (id >= 0) read[k][id] = 1;
         }
     }
     deepTiles_.shrink_to_fit();
     deepKey_ = key;
+
+    // Separated levels: the points whose phi is stored in every fit are
+    // those with a tile read by the evaluation or sent as a tile to another
+    // rank; all of them where the level is folded into the flat lattice
+    for (int k = 0; k < int(levels_.size()); ++k)
+    {
+        level& L = *levels_[k];
+        if (!L.separated) continue;
+        if (k <= flat_)
+        {
+            std::fill(L.readEveryFit.begin(), L.readEveryFit.end(), 1);
+            continue;
+        }
+        for (int r = 0; r < comm_.size() && comm_.size() > 1; ++r)
+            if (L.ghostSend[r].empty())
+                for (const std::int64_t id : L.sendTiles[r]) read[k][id] = 1;
+        for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+        {
+            L.readEveryFit[q] = 0;
+            for (const std::int32_t id : L.ctrlView[q]) if (id >= 0 && read[k][id]) L.readEveryFit[q] = 1;
+        }
+    }
 }
 
 template <int D>

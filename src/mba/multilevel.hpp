@@ -140,12 +140,11 @@ class multilevel
     void buildLevel(int k);
     void applyLevel(level& L);
     template <class F> void forOwnStencils(const level& L, F&& f) const;
+    stencil<D> ctrlStencil(const level& L, std::size_t q) const; ///< of control point ctrlOrder_[q]
     void residualStats(double& maxr, double& rms) const;
     void addLevels(const double* x, double* out, int nLevels) const;
     void fold();
     indexBox<D> evalNodeBox(int k) const;
-    /// Level k may be folded into the flat lattice (its evaluation node box is small enough)
-    bool flattens(int k) const;
     /// Stores the coefficients that separated levels leave out per fit (level::readEveryFit)
     void completeLattices() const;
     /// The components control point i constrains, in on[0..nc): on, or

@@ -192,7 +192,8 @@ std::string Foam::multilevelBSplineMotionSolver::morph
                     << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
                     << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
                     << " received " << s.bytesReceivedPerApply
-                    << " B, max residual " << s.maxResidual << ", " << s.seconds << " s" << endl;
+                    << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
+                    << s.planSeconds << " s)" << endl;
             }
         }
     }
