@@ -55,29 +55,19 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
 {
     // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
     // never sees an inverted cell): the divergence theorem over the faces,
-    // each face as its vertex mean and its area vector (twice it: for a quad
-    // the cross product of its diagonals, else the triangles about its first
-    // vertex), relative to one vertex of the cell. Exact for planar faces;
+    // 3V = sum over a cell's faces of area vector . (face point - x0) for
+    // any x0 (a closed cell's area vectors add up to 0), each face as its
+    // area vector (twice it: for a quad the cross product of its diagonals,
+    // else the triangles about its first vertex) and its vertex mean, x0 the
+    // centre of the mesh's bounds (for every cell: one term per face, added
+    // to its owner and taken from its neighbour). Exact for planar faces;
     // one pass over the faces, no square roots, no face arrays.
     const faceList& faces = mesh().faces();
     const labelList& own = mesh().faceOwner();
     const labelList& nei = mesh().faceNeighbour();
-    const label nCells = mesh().nCells();
-    if (cellRefPoint_.size() != nCells)
-    {
-        cellRefPoint_.setSize(nCells, -1);
-        // (a cell may be the neighbour of all its faces)
-        forAll(own, facei)
-        {
-            if (cellRefPoint_[own[facei]] < 0) cellRefPoint_[own[facei]] = faces[facei][0];
-        }
-        forAll(nei, facei)
-        {
-            if (cellRefPoint_[nei[facei]] < 0) cellRefPoint_[nei[facei]] = faces[facei][0];
-        }
-    }
+    const point x0 = mesh().bounds().centre();
     scalarField& vol = cellVol_;
-    vol.setSize(nCells);
+    vol.setSize(mesh().nCells());
     vol = 0;
     forAll(faces, facei)
     {
@@ -106,13 +96,11 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
                 }
             }
         }
-        const point mean = sum/f.size();
-        const label o = own[facei];
-        vol[o] += area & (mean - points[cellRefPoint_[o]]);
+        const scalar v = area & (sum/f.size() - x0);
+        vol[own[facei]] += v;
         if (facei < nei.size())
         {
-            const label c = nei[facei];
-            vol[c] -= area & (mean - points[cellRefPoint_[c]]);
+            vol[nei[facei]] -= v;
         }
     }
     label n = 0;
@@ -336,7 +324,6 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     // points0 changed: the plan is rebuilt at the next solve
     constraintsPtr_.reset();
     refitPtr_.reset();
-    cellRefPoint_.clear();
     evalPoints_.clear();
     evalXyz_.clear();
     newPoints_.clear();
