@@ -287,32 +287,39 @@ inline __attribute__((always_inline)) vrow<4*NC> loadSplit(const double* p0, con
     return r;
 }
 
-/// How a scatter writes: adds, stores, or stores the selected components only
-enum class put { add, store, select };
-
-/// The same split row += w*a (store: = w*a; select: = w*a in the components
-/// whose flag in on[0..NC) is set)
-template <int NC, int OZ, put P>
-inline __attribute__((always_inline)) void addSplit(double* p0, double* p1, double w, const vrow<4*NC>& a,
-                                                    const bool* on)
+/// The same split row += w*a
+template <int NC, int OZ>
+inline __attribute__((always_inline)) void addSplit(double* p0, double* p1, double w, const vrow<4*NC>& a)
 {
     constexpr int L = (4 - OZ)*NC;
     for (int i = 0; i < 2*NC; ++i)
     {
         const int j = 2*i;
         const v2d x = w*a.v[i];
-        // (v2du's alignment of 8 lives in its typedef: no auto& here)
-        v2du* q = reinterpret_cast<v2du*>(j + 1 < L ? p0 + OZ*NC + j : p1 + (j - L));
-        double* lo = j + 1 < L || j >= L ? reinterpret_cast<double*>(q) : p0 + OZ*NC + j;
+        if (j + 1 < L) *reinterpret_cast<v2du*>(p0 + OZ*NC + j) += x;
+        else if (j >= L) *reinterpret_cast<v2du*>(p1 + (j - L)) += x;
+        else { p0[OZ*NC + j] += x[0]; p1[0] += x[1]; }
+    }
+}
+
+/// How a scatter writes: adds, stores, or stores the selected components only
+enum class put { add, store, select };
+
+/// The same split row = w*a (select: only in the components whose flag in
+/// on[0..NC) is set)
+template <int NC, int OZ, put P>
+inline __attribute__((always_inline)) void storeSplit(double* p0, double* p1, double w, const vrow<4*NC>& a,
+                                                      const bool* on)
+{
+    constexpr int L = (4 - OZ)*NC;
+    for (int i = 0; i < 2*NC; ++i)
+    {
+        const int j = 2*i;
+        const v2d x = w*a.v[i];
+        double* lo = j >= L ? p1 + (j - L) : p0 + OZ*NC + j;
         double* hi = j + 1 < L || j >= L ? lo + 1 : p1;
-        if (P == put::select)
-        {
-            if (on[j % NC]) *lo = x[0];
-            if (on[(j + 1) % NC]) *hi = x[1];
-        }
-        else if (j + 1 < L || j >= L) { if (P == put::store) *q = x; else *q += x; }
-        else if (P == put::store) { *lo = x[0]; *hi = x[1]; }
-        else { *lo += x[0]; *hi += x[1]; }
+        if (P == put::store || on[j % NC]) *lo = x[0];
+        if (P == put::store || on[(j + 1) % NC]) *hi = x[1];
     }
 }
 
@@ -367,7 +374,8 @@ void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>&
         return id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
     };
     forRows(st, [&](int t, int n, double w) {
-        addSplit<NC, OZ, P>(row(t, n), OZ ? row(t + 1, n) : sink, w, v, on);
+        if (P == put::add) addSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : sink, w, v);
+        else storeSplit<NC, OZ, P>(row(t, n), OZ ? row(t + 1, n) : sink, w, v, on);
     });
 }
 

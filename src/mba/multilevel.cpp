@@ -96,28 +96,9 @@ namespace {
 /// of its stencil (rr = r/sum(w^2) per component), w^3 as the product of the
 /// directions' cubed weights. The point's owner and a rank holding it as a
 /// ghost both add it through here: bitwise the same sums.
-/// separated: the point is the only one at its nodes in the components it
-/// constrains (level::separated; on: those components, nullptr: all), so
-/// phi = delta/omega = w r/sum(w^2) there: that is stored, not added, and
-/// only in those components.
 template <int D>
-inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr,
-                    bool separated, const bool* on)
+inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
 {
-    if (separated)
-    {
-        using detail::put;
-        switch (nc * (on ? -1 : 1))
-        {
-            case 1: detail::scatterStencil<D, 1, put::store>(delta, tid, st, rr); break;
-            case 2: detail::scatterStencil<D, 2, put::store>(delta, tid, st, rr); break;
-            case 3: detail::scatterStencil<D, 3, put::store>(delta, tid, st, rr); break;
-            case -1: detail::scatterStencil<D, 1, put::select>(delta, tid, st, rr, on); break;
-            case -2: detail::scatterStencil<D, 2, put::select>(delta, tid, st, rr, on); break;
-            default: detail::scatterStencil<D, 3, put::select>(delta, tid, st, rr, on);
-        }
-        return;
-    }
     stencil<D> cubed = st;
     for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
     switch (nc)
@@ -125,6 +106,41 @@ inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const ste
         case 1: detail::scatterStencil<D, 1>(delta, tid, cubed, rr); break;
         case 2: detail::scatterStencil<D, 2>(delta, tid, cubed, rr); break;
         default: detail::scatterStencil<D, 3>(delta, tid, cubed, rr);
+    }
+}
+
+/// v[n*NC + c] *= s[n] for n in [0, nNodes): one scale a node, NC values
+template <int NC>
+void scaleNodes(double* v, const double* s, std::size_t nNodes)
+{
+    for (std::size_t n = 0; n < nNodes; ++n)
+        for (int c = 0; c < NC; ++c) v[n*NC + c] *= s[n];
+}
+
+/// A point of a separated level (level::separated): the only one at its
+/// nodes in the components it constrains (on: those, nullptr: all), so phi =
+/// delta/omega = w r/sum(w^2) there is stored, in those components only.
+/// The owner and a rank holding the point as a ghost both store it here.
+template <int D>
+void scatterSeparated(double* phi, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr,
+                      const bool* on)
+{
+    using detail::put;
+    if (!on)
+    {
+        switch (nc)
+        {
+            case 1: detail::scatterStencil<D, 1, put::store>(phi, tid, st, rr); break;
+            case 2: detail::scatterStencil<D, 2, put::store>(phi, tid, st, rr); break;
+            default: detail::scatterStencil<D, 3, put::store>(phi, tid, st, rr);
+        }
+        return;
+    }
+    switch (nc)
+    {
+        case 1: detail::scatterStencil<D, 1, put::select>(phi, tid, st, rr, on); break;
+        case 2: detail::scatterStencil<D, 2, put::select>(phi, tid, st, rr, on); break;
+        default: detail::scatterStencil<D, 3, put::select>(phi, tid, st, rr, on);
     }
 }
 
@@ -293,17 +309,18 @@ template <int D>
 multilevel<D>::~multilevel() = default;
 
 template <int D>
+inline __attribute__((always_inline)) stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q) const
+{
+    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data());
+}
+
+template <int D>
 template <class F>
 void multilevel<D>::forOwnStencils(const level& L, F&& f) const
 {
     for (std::size_t q = 0; q < ctrlOrder_.size(); ++q) f(std::size_t(ctrlOrder_[q]), ctrlStencil(L, q));
 }
 
-template <int D>
-stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q) const
-{
-    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data());
-}
 
 template <int D>
 void multilevel<D>::buildLevel(int k)
@@ -605,9 +622,11 @@ void multilevel<D>::applyLevel(level& L)
     const int blk = npt*nc_;
     // delta += w^2 phi_c = w^3 r_c / sum(w^2): this rank's partial sums, in
     // the view; in parallel the other ranks' are then added in rank order.
-    // Separated: phi itself is stored at the own points' nodes, which are the
-    // same in every fit (the other nodes stay 0), and only the tiles that
-    // other ranks' values are added to are cleared.
+    // Separated: phi itself is stored at the nodes of the own points that
+    // are read every fit (always the same nodes; no other point writes
+    // there), and only the tiles that other ranks' values are added to are
+    // cleared. The other points' nodes keep older values, read by nobody
+    // until completeLattices() stores them.
     if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
     else
         for (const auto& tiles : L.recvTiles)
@@ -623,10 +642,12 @@ void multilevel<D>::applyLevel(level& L)
         if (L.separated)
         {
             std::copy(rr, rr + nc_, &L.rr[pos*nc_]);
-            if (!L.readEveryFit[pos]) { ++pos; return; }
+            bool on[3];
+            if (L.readEveryFit[pos]) scatterSeparated<D>(L.phi.data(), nc_, L.ctrlView[pos], st, rr, constrained(i, on));
+            ++pos;
+            return;
         }
-        bool on[3];
-        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr, L.separated, constrained(i, on));
+        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr);
     });
     L.complete = !L.separated;
 
@@ -666,7 +687,9 @@ void multilevel<D>::applyLevel(level& L)
                     on[c] = x[D + c] != 0;
                     rr[c] = on[c] ? got[r][g*nc_ + c]/sw : 0.0;
                 }
-                scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr, L.separated, nw_ == 1 ? nullptr : on); // as the owner does
+                // as the owner does
+                if (L.separated) scatterSeparated<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr, nw_ == 1 ? nullptr : on);
+                else scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr);
             }
             got[r].swap(dl);
         }
@@ -699,13 +722,16 @@ void multilevel<D>::applyLevel(level& L)
     // too); separated levels hold phi already
     if (!L.separated && nw_ == 1)
     {
-        const std::size_t nNodes = L.invOmega.size();
-        for (std::size_t n = 0; n < nNodes; ++n)
-            for (int c = 0; c < nc_; ++c) L.phi[n*nc_ + c] *= L.invOmega[n];
+        switch (nc_)
+        {
+            case 1: scaleNodes<1>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
+            case 2: scaleNodes<2>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
+            default: scaleNodes<3>(L.phi.data(), L.invOmega.data(), L.invOmega.size());
+        }
     }
     else if (!L.separated)
     {
-        for (std::size_t j = 0; j < L.phi.size(); ++j) L.phi[j] *= L.invOmega[j];
+        scaleNodes<1>(L.phi.data(), L.invOmega.data(), L.phi.size());
     }
 
     // Residuals at this rank's control points
@@ -933,7 +959,7 @@ void multilevel<D>::completeLattices() const
         forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
             bool on[3];
             if (!L.readEveryFit[pos])
-                scatter<D>(L.phi.data(), nc_, L.ctrlView[pos], st, &L.rr[pos*nc_], true, constrained(i, on));
+                scatterSeparated<D>(L.phi.data(), nc_, L.ctrlView[pos], st, &L.rr[pos*nc_], constrained(i, on));
             ++pos;
         });
         L.complete = true;
