@@ -163,17 +163,25 @@ TEST_CASE("levels that separate the control points: serial equals simulated rank
 
 TEST_CASE("ranks without control or evaluation points", "[parallel]")
 {
-    // all control points on rank 0, all evaluation points on the last rank
-    const auto c = randomPoints<3>(800, 81);
-    const auto e = randomPoints<3>(500, 82);
+    // all control points on rank 0, all evaluation points on the last rank:
+    // random points, and two faces whose finest level is separated (rank 0
+    // then stores no coefficients for its own reading, and the last rank
+    // has only what reaches it; evaluation points next to the faces read it)
+    const bool faces = GENERATE(false, true);
+    const auto c = faces ? twoFaces<3>(13, 0.1, 83) : randomPoints<3>(800, 81);
+    auto e = randomPoints<3>(500, 82);
+    if (faces)
+        for (std::size_t i = 0; i < c.size(); i += 2)
+            e.push_back({{c[i][0], c[i][1], c[i][2] > 0.5 ? c[i][2] - 0.003 : c[i][2] + 0.003}});
     const auto v = smoothValues<3>(c, 1);
     params p;
-    p.tolerance = 1e-10;
+    p.tolerance = faces ? 1e-12 : 1e-10;
     std::vector<double> ref;
     {
         multilevel<3> m(serialCommunicator(), p, 1, c, {}, e);
-        m.fit(v);
+        const fitReport& r = m.fit(v);
         m.evaluate(ref);
+        if (faces) REQUIRE(m.stats()[r.levels - 1].separated);
     }
     const int P = 3;
     std::vector<double> got;
@@ -183,10 +191,12 @@ TEST_CASE("ranks without control or evaluation points", "[parallel]")
         const std::vector<point<3>> el = last ? e : std::vector<point<3>>{};
         multilevel<3> m(comm, p, 1, cl, {}, el);
         m.fit(first ? v : std::vector<double>{});
+        m.fit(first ? v : std::vector<double>{});  // again, with what each rank stores narrowed
         std::vector<double> o;
         m.evaluate(o);
         if (last) got = o;
     });
+    INFO("two faces " << faces);
     REQUIRE(got.size() == ref.size());
     for (std::size_t i = 0; i < ref.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(ref[i], 1e-12*maxAbs(v)));
 }
