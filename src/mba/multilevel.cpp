@@ -321,7 +321,6 @@ void multilevel<D>::forOwnStencils(const level& L, F&& f) const
     for (std::size_t q = 0; q < ctrlOrder_.size(); ++q) f(std::size_t(ctrlOrder_[q]), ctrlStencil(L, q));
 }
 
-
 template <int D>
 void multilevel<D>::buildLevel(int k)
 {
@@ -720,18 +719,14 @@ void multilevel<D>::applyLevel(level& L)
     }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
     // too); separated levels hold phi already
-    if (!L.separated && nw_ == 1)
+    if (!L.separated)
     {
-        switch (nc_)
+        switch (nw_ == 1 ? nc_ : 1)     // one 1/omega per node, or per value
         {
             case 1: scaleNodes<1>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
             case 2: scaleNodes<2>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
             default: scaleNodes<3>(L.phi.data(), L.invOmega.data(), L.invOmega.size());
         }
-    }
-    else if (!L.separated)
-    {
-        scaleNodes<1>(L.phi.data(), L.invOmega.data(), L.phi.size());
     }
 
     // Residuals at this rank's control points
