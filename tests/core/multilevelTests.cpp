@@ -218,18 +218,9 @@ void separatedLevels(bool masked)
     // control points (their stencils read the separated level)
     std::vector<point<D>> c = twoFaces<D>(D == 3 ? 9 : 17, 0.1, 51);
     std::vector<point<D>> e = randomPoints<D>(400, 52);
-    for (std::size_t i = 0; i < c.size(); i += 3)
-    {
-        point<D> x = c[i];
-        x[D - 1] = x[D - 1] > 0.5 ? x[D - 1] - 0.004 : x[D - 1] + 0.004;
-        e.push_back(x);
-    }
-    std::vector<std::uint8_t> mask;
-    if (masked)
-    {
-        mask.assign(c.size()*3, 1);
-        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*3 + i % 3] = 0;
-    }
+    const std::vector<point<D>> near = insideFaces<D>(c, 3, 0.004);
+    e.insert(e.end(), near.begin(), near.end());
+    std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), 3) : std::vector<std::uint8_t>();
     INFO("D " << D << ", masked " << masked);
     const std::vector<levelStats> st = equalsPlainMBA<D>(c, mask, e);
     // the last level separates the points (that is why the residual is

@@ -77,12 +77,7 @@ void serialEqualsRanks(bool affine, bool masked, partition how)
     pb.p.tolerance = 1e-9;
     pb.p.bucketTiles = 8;
     const std::vector<double> v = smoothValues<D>(c, pb.nc);
-    std::vector<std::uint8_t> mask;
-    if (masked)
-    {
-        mask.assign(c.size()*pb.nc, 1);
-        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*pb.nc + i % 3] = 0;
-    }
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
     const std::vector<double> ref = solve<D>(1, how, c, v, mask, e, pb);
     const double tol = 1e-12*maxAbs(v);
     for (int P : {2, 3, 5, 8})
@@ -126,22 +121,13 @@ TEST_CASE("levels that separate the control points: serial equals simulated rank
     const partition how = GENERATE(partition::slabs, partition::random);
     const std::vector<point<3>> c = twoFaces<3>(13, 0.1, 61);
     std::vector<point<3>> e = randomPoints<3>(600, 62);
-    for (std::size_t i = 0; i < c.size(); i += 2)
-    {
-        point<3> x = c[i];
-        x[2] = x[2] > 0.5 ? x[2] - 0.003 : x[2] + 0.003;
-        e.push_back(x);
-    }
+    const std::vector<point<3>> near = insideFaces<3>(c, 2, 0.003);
+    e.insert(e.end(), near.begin(), near.end());
     problem pb;
     pb.p.tolerance = 1e-12;
     pb.p.bucketTiles = 8;
     const std::vector<double> v = smoothValues<3>(c, pb.nc);
-    std::vector<std::uint8_t> mask;
-    if (masked)
-    {
-        mask.assign(c.size()*pb.nc, 1);
-        for (std::size_t i = 0; i < c.size(); i += 2) mask[i*pb.nc + i % 3] = 0;
-    }
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
     {
         // (the finest level used does separate them)
         multilevel<3> m(serialCommunicator(), pb.p, pb.nc, c, mask, e);
@@ -171,8 +157,10 @@ TEST_CASE("ranks without control or evaluation points", "[parallel]")
     const auto c = faces ? twoFaces<3>(13, 0.1, 83) : randomPoints<3>(800, 81);
     auto e = randomPoints<3>(500, 82);
     if (faces)
-        for (std::size_t i = 0; i < c.size(); i += 2)
-            e.push_back({{c[i][0], c[i][1], c[i][2] > 0.5 ? c[i][2] - 0.003 : c[i][2] + 0.003}});
+    {
+        const std::vector<point<3>> near = insideFaces<3>(c, 2, 0.003);
+        e.insert(e.end(), near.begin(), near.end());
+    }
     const auto v = smoothValues<3>(c, 1);
     params p;
     p.tolerance = faces ? 1e-12 : 1e-10;

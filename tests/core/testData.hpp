@@ -85,6 +85,30 @@ std::vector<mba::point<D>> twoFaces(int k, double jitter, unsigned seed)
     return p;
 }
 
+/// Every step-th of points on the faces x_(D-1) = 0 and 1, moved d inside:
+/// evaluation points whose stencils read the faces' finest levels
+template <int D>
+std::vector<mba::point<D>> insideFaces(const std::vector<mba::point<D>>& c, std::size_t step, double d)
+{
+    std::vector<mba::point<D>> p;
+    for (std::size_t i = 0; i < c.size(); i += step)
+    {
+        mba::point<D> x = c[i];
+        x[D - 1] = x[D - 1] > 0.5 ? x[D - 1] - d : x[D - 1] + d;
+        p.push_back(x);
+    }
+    return p;
+}
+
+/// A mask (point x component) in which every other of n points leaves one
+/// of its nc components free, in turn: components with mixed masks
+inline std::vector<std::uint8_t> mixedMask(std::size_t n, int nc)
+{
+    std::vector<std::uint8_t> mask(n*nc, 1);
+    for (std::size_t i = 0; i < n; i += 2) mask[i*nc + i % nc] = 0;
+    return mask;
+}
+
 /// The method written out plainly, as an oracle: the paper's Eq. 5-6 level
 /// after level, each level's lattice a std::map of the nodes the control
 /// points' stencils touch, omega per component over the points that
