@@ -64,7 +64,7 @@ template <int D>
 affineFit<D>::affineFit(const communicator& comm, int nc, pointsView<D> x,
                         const std::vector<std::uint8_t>& mask, const point<D>& centre, double scale)
 :
-    nc_(nc), centre_(centre), scale_(scale)
+    nc_(nc), centre_(centre), invScale_(1/scale)
 {
     constexpr int n = D + 1;
     std::vector<double> A(nc*n*n, 0.0);

@@ -22,14 +22,14 @@ class affineFit
 {
     int nc_ = 0;
     point<D> centre_{};
-    double scale_ = 1;
+    double invScale_ = 1;        ///< 1/scale: a multiplication per coordinate (evaluated at every mesh point)
     std::vector<double> pinv_;   ///< per component (D+1)^2
     std::vector<double> coeff_;  ///< per component D+1 (in scaled coordinates)
 
     void basis(const double* x, double* b) const
     {
         b[0] = 1;
-        for (int d = 0; d < D; ++d) b[d + 1] = (x[d] - centre_[d])/scale_;
+        for (int d = 0; d < D; ++d) b[d + 1] = (x[d] - centre_[d])*invScale_;
     }
 
 public:

@@ -14,6 +14,7 @@
 #include "hashMap.hpp"
 
 #include <cmath>
+#include <type_traits>
 
 namespace mba {
 
@@ -119,13 +120,15 @@ template <int D> struct stencil
 
     /// From level-local coordinates u >= 0 (as domain::local0 makes them):
     /// cell floor(u), s = u - floor(u); floor as truncation, which is one
-    /// instruction on every x86-64 (std::floor is a call without SSE4.1)
-    explicit stencil(const double* u)
+    /// instruction on every x86-64 (std::floor is a call without SSE4.1).
+    /// cubed: the weights cubed (the fit's scatter)
+    explicit stencil(const double* u, bool cubed = false)
     {
         for (int d = 0; d < D; ++d)
         {
             base[d] = std::int64_t(u[d]);
             cubicBasis(u[d] - double(base[d]), w[d]);
+            if (cubed) for (double& x : w[d]) x = x*x*x;
         }
     }
 
@@ -176,52 +179,111 @@ bool findTiles(const tileLayout<D>& L, const stencil<D>& st, stencilTiles<D>& ti
     return any;
 }
 
+#if defined(__GNUC__) && defined(__x86_64__)
+/// Kernels also compiled for AVX2 with FMA (vectors of four doubles), used
+/// where the processor has them; the library itself is built for any x86-64
+#define MBA_WIDE_VECTORS 1
+#define MBA_WIDE_TARGET __attribute__((target("avx2,fma")))
+#endif
+
 namespace detail {
-/// Rows of N doubles as vectors of two (GCC's vector extension: SSE2 on
-/// x86-64, NEON on arm64), kept in registers; per lane the same arithmetic as
-/// scalar code
-typedef double v2d __attribute__((vector_size(16)));
-typedef double v2du __attribute__((vector_size(16), aligned(8), may_alias)); ///< unaligned, in arrays of double
-template <int N> struct vrow
+inline bool& wideFlag()
 {
-    static_assert(N % 2 == 0, "rows of 4 nodes");
-    v2d v[N/2];
+#ifdef MBA_WIDE_VECTORS
+    static bool on = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+    static bool on = false;
+#endif
+    return on;
+}
+}
+
+/// Whether the kernels run on vectors of four doubles (AVX2 with FMA, chosen
+/// at run time on x86-64). Their results differ from the two-double kernels'
+/// by rounding only.
+inline bool wideVectors() { return detail::wideFlag(); }
+
+/// Turns them off, or on again where the processor has them; returns the
+/// previous setting. For tests comparing the two.
+inline bool useWideVectors(bool on)
+{
+    const bool was = detail::wideFlag();
+#ifdef MBA_WIDE_VECTORS
+    detail::wideFlag() = on && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+    (void)on;
+#endif
+    return was;
+}
+
+namespace detail {
+/// Vectors of W doubles (GCC's vector extension): W = 2 is SSE2 on x86-64 and
+/// NEON on arm64; W = 4 (AVX2) only in code compiled for it (wideVectors)
+template <int W> struct vec;
+template <> struct vec<2>
+{
+    typedef double type __attribute__((vector_size(16)));
+    typedef double unaligned __attribute__((vector_size(16), aligned(8), may_alias)); ///< in arrays of double
+};
+template <> struct vec<4>
+{
+    typedef double type __attribute__((vector_size(32)));
+    typedef double unaligned __attribute__((vector_size(32), aligned(8), may_alias));
+};
+typedef vec<2>::type v2d;
+typedef vec<2>::unaligned v2du;
+
+/// Rows of N doubles as vectors of W, kept in registers; per lane the same
+/// arithmetic as scalar code
+template <int N, int W = 2> struct vrow
+{
+    static_assert(N % W == 0, "rows of 4 nodes");
+    typename vec<W>::type v[N/W];
 
     /// The row p[0..N)
     static inline __attribute__((always_inline)) vrow load(const double* p)
     {
         vrow r;
-        const v2du* q = reinterpret_cast<const v2du*>(p);
-        for (int i = 0; i < N/2; ++i) r.v[i] = q[i];
+        typedef typename vec<W>::unaligned U;   // (not auto: that would drop the alignment of 8)
+        const U* q = reinterpret_cast<const U*>(p);
+        for (int i = 0; i < N/W; ++i) r.v[i] = q[i];
         return r;
     }
 
     /// Stores the row to p[0..N)
-    void store(double* p) const
+    inline __attribute__((always_inline)) void store(double* p) const
     {
-        v2du* q = reinterpret_cast<v2du*>(p);
-        for (int i = 0; i < N/2; ++i) q[i] = v[i];
+        typedef typename vec<W>::unaligned U;
+        U* q = reinterpret_cast<U*>(p);
+        for (int i = 0; i < N/W; ++i) q[i] = v[i];
     }
 };
 
 /// a += w*b
-template <int N>
-inline __attribute__((always_inline)) void axpy(vrow<N>& a, double w, const vrow<N>& b)
+template <int N, int W>
+inline __attribute__((always_inline)) void axpy(vrow<N, W>& a, double w, const vrow<N, W>& b)
 {
-    for (int i = 0; i < N/2; ++i) a.v[i] += w*b.v[i];
+    for (int i = 0; i < N/W; ++i) a.v[i] += w*b.v[i];
 }
 
 /// a += w*p (p a row in memory)
-template <int N>
-inline __attribute__((always_inline)) void axpy(vrow<N>& a, double w, const double* p)
+template <int N, int W = 2>
+inline __attribute__((always_inline)) void axpy(vrow<N, W>& a, double w, const double* p)
 {
-    axpy<N>(a, w, vrow<N>::load(p));
+    axpy<N, W>(a, w, vrow<N, W>::load(p));
+}
+
+/// a += b
+template <int N, int W>
+inline __attribute__((always_inline)) void add(vrow<N, W>& a, const vrow<N, W>& b)
+{
+    for (int i = 0; i < N/W; ++i) a.v[i] += b.v[i];
 }
 
 /// Adds to out[0..NC) the row sum r (4 nodes of NC values along the last
 /// direction) weighted by the stencil's last-direction weights w
-template <int NC>
-inline __attribute__((always_inline)) void addRowSum(const vrow<4*NC>& r, const double* w, double* out)
+template <int NC, int W = 2>
+inline __attribute__((always_inline)) void addRowSum(const vrow<4*NC, W>& r, const double* w, double* out)
 {
     double s[4*NC];
     r.store(s);
@@ -252,6 +314,20 @@ inline __attribute__((always_inline)) void forRows(const stencil<2>& st, F&& f)
 {
     const int ox = int(st.base[0] & 3);
     for (int a = 0; a < 4; ++a) f(((ox + a) >> 2)*2, ((ox + a) & 3)*tileEdge, st.w[0][a]);
+}
+
+/// f(oz) with oz an std::integral_constant: the stencil's first node within
+/// its tile along the last direction (the kernels are compiled per offset)
+template <int D, class F>
+inline __attribute__((always_inline)) void withOffset(const stencil<D>& st, F&& f)
+{
+    switch (st.base[D - 1] & 3)
+    {
+        case 0: f(std::integral_constant<int, 0>()); break;
+        case 1: f(std::integral_constant<int, 1>()); break;
+        case 2: f(std::integral_constant<int, 2>()); break;
+        default: f(std::integral_constant<int, 3>());
+    }
 }
 
 /// Visits the stencil's nodes in existing tiles: f(tileId, nodeInTile, weight)
@@ -344,16 +420,48 @@ void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D
     addRowSum<NC>(acc, st.w[D - 1], out);
 }
 
+#ifdef MBA_WIDE_VECTORS
+/// sweepStencil in vectors of four doubles: each stencil row is read as whole
+/// tile rows (4 nodes from node 0, aligned), the one holding its first nodes
+/// into accumulator a[0] and, when OZ > 0, the next tile's into a[1] (for OZ
+/// = 0 the two take alternate rows: two add chains either way); node c of
+/// the stencil row is then node OZ + c of the tile rows a[0] | a[1]
+template <int D, int NC, int OZ>
+MBA_WIDE_TARGET void sweepStencilWide(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st,
+                                      double* out)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    static constexpr double zero[R] = {};
+    auto row = [phi, &tid](int t, int n) __attribute__((always_inline)) {
+        const std::int32_t id = tid[t];
+        return id >= 0 ? phi + (std::int64_t(id)*npt + n)*NC : zero;
+    };
+    vrow<R, 4> a[2] = {};
+    int i = 0;
+    forRows(st, [&](int t, int n, double w) __attribute__((always_inline)) {
+        if (OZ) axpy<R, 4>(a[1], w, row(t + 1, n));
+        axpy<R, 4>(a[OZ ? 0 : i++ & 1], w, row(t, n));
+    });
+    if (!OZ) add(a[0], a[1]);
+    double s[2*R];
+    a[0].store(s);
+    a[1].store(s + R);
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) out[k] += st.w[D - 1][c]*s[(OZ + c)*NC + k];
+}
+#endif
+
 template <int D, int NC>
 void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
 {
-    switch (st.base[D - 1] & 3)
+#ifdef MBA_WIDE_VECTORS
+    if (wideVectors())
     {
-        case 0: sweepStencil<D, NC, 0>(phi, tid, st, out); break;
-        case 1: sweepStencil<D, NC, 1>(phi, tid, st, out); break;
-        case 2: sweepStencil<D, NC, 2>(phi, tid, st, out); break;
-        default: sweepStencil<D, NC, 3>(phi, tid, st, out);
+        withOffset(st, [&](auto oz) { sweepStencilWide<D, NC, decltype(oz)::value>(phi, tid, st, out); });
+        return;
     }
+#endif
+    withOffset(st, [&](auto oz) { sweepStencil<D, NC, decltype(oz)::value>(phi, tid, st, out); });
 }
 
 /// Adds w_n r (NC values) to each node n of the stencil, w_n the product of
@@ -379,17 +487,120 @@ void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>&
     });
 }
 
+#ifdef MBA_WIDE_VECTORS
+/// scatterStencil's add in vectors of four doubles: whole tile rows (as in
+/// sweepStencilWide) += w u, u holding w_c r at node OZ + c of the tile rows
+/// and 0 at their other nodes
+template <int D, int NC, int OZ>
+MBA_WIDE_TARGET void scatterStencilWide(double* delta, const stencilTiles<D>& tid, const stencil<D>& st,
+                                        const double* r)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    double u[2*R] = {}, sink[R];
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) u[(OZ + c)*NC + k] = st.w[D - 1][c]*r[k];
+    const vrow<R, 4> ua = vrow<R, 4>::load(u), ub = vrow<R, 4>::load(u + R);
+    auto addRow = [delta, &tid, &sink](int t, int n, double w, const vrow<R, 4>& v) __attribute__((always_inline)) {
+        const std::int32_t id = tid[t];
+        double* p = id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
+        vrow<R, 4> x = vrow<R, 4>::load(p);
+        axpy<R, 4>(x, w, v);
+        x.store(p);
+    };
+    forRows(st, [&](int t, int n, double w) __attribute__((always_inline)) {
+        addRow(t, n, w, ua);
+        if (OZ) addRow(t + 1, n, w, ub);
+    });
+}
+
+/// scatterStencilWide for a run of n points whose stencils share their nodes
+/// (the same first node: coarse levels, where many points lie in one cell):
+/// per chunk of points, each tile row's sum over the chunk is formed in
+/// registers and added to the lattice once (st: the points' stencils, r:
+/// their values, NC a point)
+template <int D, int NC, int OZ>
+MBA_WIDE_TARGET void scatterRunWide(double* delta, const stencilTiles<D>& tid, const stencil<D>* st,
+                                    const double* r, std::size_t n)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC, H = OZ ? 2 : 1;
+    constexpr int nRows = D == 3 ? 16 : 4;
+    constexpr std::size_t chunk = 16;
+    double sink[R];
+    int rowT[nRows], rowN[nRows];
+    {
+        int j = 0;
+        forRows(st[0], [&](int t, int nn, double) { rowT[j] = t; rowN[j] = nn; ++j; });
+    }
+    vrow<R, 4> u[chunk][H];        // per point: its values times the last direction's weights, by tile row
+    double w[chunk][nRows];        // per point: its rows' weights in the other directions
+    for (std::size_t p0 = 0; p0 < n; p0 += chunk)
+    {
+        const std::size_t m = std::min(chunk, n - p0);
+        for (std::size_t j = 0; j < m; ++j)
+        {
+            const stencil<D>& sj = st[p0 + j];
+            double uj[2*R] = {};
+            for (int c = 0; c < 4; ++c)
+                for (int k = 0; k < NC; ++k) uj[(OZ + c)*NC + k] = sj.w[D - 1][c]*r[(p0 + j)*NC + k];
+            for (int h = 0; h < H; ++h) u[j][h] = vrow<R, 4>::load(uj + h*R);
+            int i = 0;
+            forRows(sj, [&](int, int, double wr) { w[j][i++] = wr; });
+        }
+        // two rows at a time: independent add chains
+        for (int i = 0; i < nRows; i += 2)
+        {
+            vrow<R, 4> acc[2][H] = {};
+            for (std::size_t j = 0; j < m; ++j)
+                for (int h = 0; h < H; ++h)
+                {
+                    axpy<R, 4>(acc[0][h], w[j][i], u[j][h]);
+                    axpy<R, 4>(acc[1][h], w[j][i + 1], u[j][h]);
+                }
+            for (int e = 0; e < 2; ++e)
+                for (int h = 0; h < H; ++h)
+                {
+                    const std::int32_t id = tid[rowT[i + e] + h];
+                    double* p = id >= 0 ? delta + (std::int64_t(id)*npt + rowN[i + e])*NC : sink;
+                    vrow<R, 4> x = vrow<R, 4>::load(p);
+                    add(x, acc[e][h]);
+                    x.store(p);
+                }
+        }
+    }
+}
+#endif
+
 template <int D, int NC, put P = put::add>
 void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r,
-                    const bool* on = nullptr)
+                    const bool* on = nullptr);
+
+/// A run of n points whose stencils share their nodes (the same first node),
+/// scattered (put::add) point after point, or as scatterRunWide does
+template <int D, int NC>
+void scatterRun(double* delta, const stencilTiles<D>& tid, const stencil<D>* st, const double* r, std::size_t n)
 {
-    switch (st.base[D - 1] & 3)
+#ifdef MBA_WIDE_VECTORS
+    if (wideVectors())
     {
-        case 0: scatterStencil<D, NC, 0, P>(delta, tid, st, r, on); break;
-        case 1: scatterStencil<D, NC, 1, P>(delta, tid, st, r, on); break;
-        case 2: scatterStencil<D, NC, 2, P>(delta, tid, st, r, on); break;
-        default: scatterStencil<D, NC, 3, P>(delta, tid, st, r, on);
+        withOffset(st[0], [&](auto oz) { scatterRunWide<D, NC, decltype(oz)::value>(delta, tid, st, r, n); });
+        return;
     }
+#endif
+    for (std::size_t j = 0; j < n; ++j) scatterStencil<D, NC>(delta, tid, st[j], r + j*NC);
+}
+
+template <int D, int NC, put P>
+void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r,
+                    const bool* on)
+{
+#ifdef MBA_WIDE_VECTORS
+    if (P == put::add && wideVectors())
+    {
+        withOffset(st, [&](auto oz) { scatterStencilWide<D, NC, decltype(oz)::value>(delta, tid, st, r); });
+        return;
+    }
+#endif
+    withOffset(st, [&](auto oz) { scatterStencil<D, NC, decltype(oz)::value, P>(delta, tid, st, r, on); });
 }
 } // namespace detail
 

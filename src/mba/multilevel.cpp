@@ -83,6 +83,7 @@ struct multilevel<D>::level
     /// ghostX[r]: r's ghost points, D coordinates + nc mask flags each;
     /// ghostTiles[r]: their stencils' tiles, as positions in recvTiles[r]
     std::vector<std::vector<std::uint32_t>> ghostSend;
+    bool ghosts = false;            ///< this rank sends or receives ghosts at this level
     std::vector<std::vector<double>> ghostX;
     std::vector<std::vector<stencilTiles<D>>> ghostTiles;
     levelStats stats;
@@ -94,13 +95,12 @@ namespace {
 
 /// One control point's part of the partial delta: w^3 r/sum(w^2) on each node
 /// of its stencil (rr = r/sum(w^2) per component), w^3 as the product of the
-/// directions' cubed weights. The point's owner and a rank holding it as a
-/// ghost both add it through here: bitwise the same sums.
+/// directions' cubed weights (the stencil cubed: its weights cubed). The
+/// point's owner and a rank holding it as a ghost both add it through here:
+/// bitwise the same sums.
 template <int D>
-inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& st, const double* rr)
+inline void scatter(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>& cubed, const double* rr)
 {
-    stencil<D> cubed = st;
-    for (auto& wd : cubed.w) for (double& w : wd) w = w*w*w;
     switch (nc)
     {
         case 1: detail::scatterStencil<D, 1>(delta, tid, cubed, rr); break;
@@ -115,6 +115,24 @@ void scaleNodes(double* v, const double* s, std::size_t nNodes)
 {
     for (std::size_t n = 0; n < nNodes; ++n)
         for (int c = 0; c < NC; ++c) v[n*NC + c] *= s[n];
+}
+
+/// Runs shorter than this (single points) are scattered point after point
+constexpr std::size_t minRun = 2;
+
+/// scatter for a run of n points whose stencils share their nodes (cubed:
+/// their stencils cubed, rr: nc values a point); the sums are formed in
+/// another order than point after point
+template <int D>
+inline void scatterRun(double* delta, int nc, const stencilTiles<D>& tid, const stencil<D>* cubed,
+                       const double* rr, std::size_t n)
+{
+    switch (nc)
+    {
+        case 1: detail::scatterRun<D, 1>(delta, tid, cubed, rr, n); break;
+        case 2: detail::scatterRun<D, 2>(delta, tid, cubed, rr, n); break;
+        default: detail::scatterRun<D, 3>(delta, tid, cubed, rr, n);
+    }
 }
 
 /// A point of a separated level (level::separated): the only one at its
@@ -572,6 +590,8 @@ void multilevel<D>::buildLevel(int k)
             for (std::int32_t& id : tid) if (id >= 0) id = at[id];
         }
     }
+    for (const auto& g : L.ghostSend) L.ghosts = L.ghosts || !g.empty();
+    for (const auto& g : L.ghostTiles) L.ghosts = L.ghosts || !g.empty();
     L.phi.assign(L.view.size()*npt*nc_, 0.0);
     precondition(L.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L.separated)
@@ -630,24 +650,54 @@ void multilevel<D>::applyLevel(level& L)
     else
         for (const auto& tiles : L.recvTiles)
             for (const std::int64_t id : tiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);
-    std::size_t pos = 0;
-    stencils_.resize(ctrlOrder_.size());
-    forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
-        stencils_[pos] = st;    // again for the residuals below
-        const double sw = st.sumSquares();
-        double rr[3] = {0, 0, 0};
+    // The stencils (again for the residuals below) and, for the scatter,
+    // their cubed weights, in a pass of their own: the scatter's vector loads
+    // then read weights stored long before (loads of values just stored in
+    // smaller pieces stall until the stores retire)
+    const std::size_t nq = ctrlOrder_.size();
+    stencils_.resize(nq);
+    cubed_.resize(L.separated ? 0 : nq);
+    for (std::size_t q = 0; q < nq; ++q)
+    {
+        const point<D> u = scaled<D>(ctrlU0_[q], L.scale);
+        stencils_[q] = stencil<D>(u.data());
+        if (!L.separated) cubed_[q] = stencil<D>(u.data(), true);
+    }
+    // r/sum(w^2) per point
+    std::vector<double>& rr = L.separated ? L.rr : rr_;
+    rr.resize(nq*nc_);
+    for (std::size_t q = 0; q < nq; ++q)
+    {
+        const std::size_t i = ctrlOrder_[q];
+        const double isw = 1/stencils_[q].sumSquares();
         for (int c = 0; c < nc_; ++c)
-            rr[c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]/sw : 0.0;
-        if (L.separated)
+            rr[q*nc_ + c] = (mask_.empty() || mask_[i*nc_ + c]) ? residual_[i*nc_ + c]*isw : 0.0;
+    }
+    if (L.separated)
+    {
+        for (std::size_t q = 0; q < nq; ++q)
         {
-            std::copy(rr, rr + nc_, &L.rr[pos*nc_]);
             bool on[3];
-            if (L.readEveryFit[pos]) scatterSeparated<D>(L.phi.data(), nc_, L.ctrlView[pos], st, rr, constrained(i, on));
-            ++pos;
-            return;
+            if (L.readEveryFit[q])
+                scatterSeparated<D>(L.phi.data(), nc_, L.ctrlView[q], stencils_[q], &rr[q*nc_], constrained(ctrlOrder_[q], on));
         }
-        scatter<D>(L.phi.data(), nc_, L.ctrlView[pos++], st, rr);
-    });
+    }
+    else if (!L.ghosts)
+    {
+        // runs of points with the same stencil nodes at once (coarse levels;
+        // short runs point after point)
+        for (std::size_t q = 0, e; q < nq; q = e)
+        {
+            for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
+            if (e - q >= minRun) scatterRun<D>(L.phi.data(), nc_, L.ctrlView[q], &cubed_[q], &rr[q*nc_], e - q);
+            else for (std::size_t j = q; j < e; ++j) scatter<D>(L.phi.data(), nc_, L.ctrlView[j], cubed_[j], &rr[j*nc_]);
+        }
+    }
+    else
+    {
+        // (point after point, as the ranks holding them as ghosts do)
+        for (std::size_t q = 0; q < nq; ++q) scatter<D>(L.phi.data(), nc_, L.ctrlView[q], cubed_[q], &rr[q*nc_]);
+    }
     L.complete = !L.separated;
 
     if (P > 1)
@@ -677,18 +727,19 @@ void multilevel<D>::applyLevel(level& L)
             for (std::size_t g = 0; g < L.ghostTiles[r].size(); ++g)
             {
                 const double* x = &L.ghostX[r][g*stride];
-                const stencil<D> st(scaled<D>(dom_.local0(x), L.scale).data());
-                const double sw = st.sumSquares();
+                const point<D> u = scaled<D>(dom_.local0(x), L.scale);
+                const stencil<D> st(u.data());
+                const double isw = 1/st.sumSquares();
                 double rr[3] = {0, 0, 0};
                 bool on[3];
                 for (int c = 0; c < nc_; ++c)
                 {
                     on[c] = x[D + c] != 0;
-                    rr[c] = on[c] ? got[r][g*nc_ + c]/sw : 0.0;
+                    rr[c] = on[c] ? got[r][g*nc_ + c]*isw : 0.0;
                 }
                 // as the owner does
                 if (L.separated) scatterSeparated<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr, nw_ == 1 ? nullptr : on);
-                else scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr);
+                else scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], stencil<D>(u.data(), true), rr);
             }
             got[r].swap(dl);
         }
@@ -752,18 +803,19 @@ void multilevel<D>::applyLevel(level& L)
 template <int D>
 void multilevel<D>::residualStats(double& maxr, double& rms) const
 {
-    double m = 0, s = 0, n = 0;
-    for (std::size_t i = 0; i < ctrl_.size; ++i)
-        for (int c = 0; c < nc_; ++c)
-        {
-            if (!(mask_.empty() || mask_[i*nc_ + c])) continue;
-            const double r = residual_[i*nc_ + c];
-            m = std::max(m, std::abs(r));
-            s += r*r;
-            n += 1;
-        }
-    maxr = comm_.max(m);
-    const std::vector<double> sn = comm_.sum(std::vector<double>{s, n});
+    // (four partial maxima and sums: independent chains)
+    double m[4] = {0, 0, 0, 0}, s[4] = {0, 0, 0, 0};
+    const bool all = mask_.empty();
+    const std::size_t nv = ctrl_.size*nc_;
+    for (std::size_t j = 0; j < nv; ++j)
+    {
+        const double r = all || mask_[j] ? residual_[j] : 0.0;
+        m[j & 3] = std::max(m[j & 3], std::abs(r));
+        s[j & 3] += r*r;
+    }
+    const double n = all ? double(nv) : double(nv - std::count(mask_.begin(), mask_.end(), std::uint8_t(0)));
+    maxr = comm_.max(std::max(std::max(m[0], m[1]), std::max(m[2], m[3])));
+    const std::vector<double> sn = comm_.sum(std::vector<double>{(s[0] + s[1]) + (s[2] + s[3]), n});
     rms = sn[1] > 0 ? std::sqrt(sn[0]/sn[1]) : 0.0;
 }
 
@@ -859,72 +911,129 @@ void refine(std::vector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb
     for (int d = 0; d < D; ++d) n[d] = cb.hi[d] - cb.lo[d] + 1;
     std::vector<std::int64_t> pj;
     std::vector<double> pw;
-    std::vector<int> np;
     for (int d = 0; d < D; ++d)
     {
         std::int64_t outer = 1, inner = nc;
         for (int e = 0; e < d; ++e) outer *= n[e];
         for (int e = d + 1; e < D; ++e) inner *= n[e];
         const std::int64_t nf = fb.hi[d] - fb.lo[d] + 1, nco = n[d];
+        // Three parents a fine node (a missing one with weight 0 at coarse
+        // node 0: the same sums)
         pj.assign(3*nf, 0);
         pw.assign(3*nf, 0.0);
-        np.assign(nf, 0);
         for (std::int64_t jf = 0; jf < nf; ++jf)
         {
-            np[jf] = parents(fb.lo[d] + jf, cb.lo[d], cb.hi[d], &pj[3*jf], &pw[3*jf]);
-            for (int q = 0; q < np[jf]; ++q) pj[3*jf + q] -= cb.lo[d];
+            const int np = parents(fb.lo[d] + jf, cb.lo[d], cb.hi[d], &pj[3*jf], &pw[3*jf]);
+            for (int q = 0; q < np; ++q) pj[3*jf + q] -= cb.lo[d];
         }
-        T.assign(std::size_t(outer*nf*inner), 0.0);
+        T.resize(std::size_t(outer*nf*inner));
         for (std::int64_t o = 0; o < outer; ++o)
             for (std::int64_t jf = 0; jf < nf; ++jf)
             {
                 double* t = &T[(o*nf + jf)*inner];
-                for (int q = 0; q < np[jf]; ++q)
-                {
-                    const double* g = &G[(o*nco + pj[3*jf + q])*inner];
-                    const double w = pw[3*jf + q];
-                    for (std::int64_t i = 0; i < inner; ++i) t[i] += w*g[i];
-                }
+                const double* g0 = &G[(o*nco + pj[3*jf])*inner];
+                const double* g1 = &G[(o*nco + pj[3*jf + 1])*inner];
+                const double* g2 = &G[(o*nco + pj[3*jf + 2])*inner];
+                const double w0 = pw[3*jf], w1 = pw[3*jf + 1], w2 = pw[3*jf + 2];
+                for (std::int64_t i = 0; i < inner; ++i) t[i] = w0*g0[i] + w1*g1[i] + w2*g2[i];
             }
         n[d] = nf;
         G.swap(T);
     }
 }
 
-/// Adds the value at a stencil of a plain lattice (nodes of box b, the last
-/// direction fastest, NC values per node): the 4 nodes along the last
-/// direction are contiguous, so the 4^(D-1) rows are summed first
-template <int NC>
-void flatStencil(const double* G, const indexBox<3>& b, const stencil<3>& st, double* out)
+/// Node i of a plain lattice over the nodes of box b (the last direction
+/// fastest, nc values a node)
+inline const double* flatNode(const double* G, const indexBox<3>& b, const index<3>& i, int nc)
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
-    const double* p0 = G + (((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*n2 + (st.base[2] - b.lo[2]))*NC;
-    detail::vrow<4*NC> r = {};
-    for (int a = 0; a < 4; ++a)
-        for (int c = 0; c < 4; ++c) detail::axpy<4*NC>(r, st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
-    detail::addRowSum<NC>(r, st.w[2], out);
+    return G + (((i[0] - b.lo[0])*n1 + (i[1] - b.lo[1]))*n2 + (i[2] - b.lo[2]))*nc;
 }
 
-template <int NC>
-void flatStencil(const double* G, const indexBox<2>& b, const stencil<2>& st, double* out)
+/// Adds the value at a stencil of a plain lattice (nodes of box b, the last
+/// direction fastest, NC values per node): the 4 nodes along the last
+/// direction are contiguous, so the 4^(D-1) rows are summed first, as
+/// vectors of W doubles, into two accumulators (alternate rows: two
+/// independent add chains)
+template <int NC, int W>
+inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<3>& b,
+                                                       const stencil<3>& st, double* out)
+{
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
+    const double* p0 = flatNode(G, b, st.base, NC);
+    detail::vrow<4*NC, W> r[2] = {};
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
+    detail::add(r[0], r[1]);
+    detail::addRowSum<NC, W>(r[0], st.w[2], out);
+}
+
+template <int NC, int W>
+inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<2>& b,
+                                                       const stencil<2>& st, double* out)
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
     const double* p0 = G + ((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*NC;
-    detail::vrow<4*NC> r = {};
-    for (int a = 0; a < 4; ++a) detail::axpy<4*NC>(r, st.w[0][a], p0 + a*n1*NC);
-    detail::addRowSum<NC>(r, st.w[1], out);
+    detail::vrow<4*NC, W> r[2] = {};
+    for (int a = 0; a < 4; ++a) detail::axpy<4*NC, W>(r[a & 1], st.w[0][a], p0 + a*n1*NC);
+    detail::add(r[0], r[1]);
+    detail::addRowSum<NC, W>(r[0], st.w[1], out);
 }
 
-template <int D>
-void flatStencil(const double* G, const indexBox<D>& b, int nc, const stencil<D>& st, double* out)
+/// Asks the cache for the rows of the flat lattice's stencil at u (level-local
+/// coordinates): the lattice is too large for the nearer caches, and rows
+/// along the first directions lie planes apart
+inline __attribute__((always_inline)) void prefetchRows(const double* G, const indexBox<3>& b, int nc,
+                                                        const point<3>& u)
 {
-    switch (nc)
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
+    const index<3> base{{std::int64_t(u[0]), std::int64_t(u[1]), std::int64_t(u[2])}};  // as stencil's
+    const double* p0 = flatNode(G, b, base, nc);
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c)
+        {
+            const double* p = p0 + (a*n1 + c)*n2*nc;
+            __builtin_prefetch(p);              // a row's first and last value:
+            __builtin_prefetch(p + 4*nc - 1);   // the cache lines it spans
+        }
+}
+/// (2D lattices are small enough)
+inline void prefetchRows(const double*, const indexBox<2>&, int, const point<2>&) {}
+
+/// Points ahead whose stencil rows flatSweep asks the cache for (about the
+/// time a point takes against the latency of memory)
+constexpr std::size_t prefetchDistance = 4;
+
+/// The flat lattice's values at the points with level-0 local coordinates
+/// u0[0..n), to out (nc a point)
+template <int D, int W>
+inline __attribute__((always_inline)) void flatSweep(const double* G, const indexBox<D>& b, int nc, double sf,
+                                                     const point<D>* u0, std::size_t n, double* out)
+{
+    for (std::size_t q = 0; q < n; ++q)
     {
-        case 1: flatStencil<1>(G, b, st, out); break;
-        case 2: flatStencil<2>(G, b, st, out); break;
-        default: flatStencil<3>(G, b, st, out);
+        if (q + prefetchDistance < n) prefetchRows(G, b, nc, scaled<D>(u0[q + prefetchDistance], sf));
+        double acc[3] = {0, 0, 0};
+        const stencil<D> st(scaled<D>(u0[q], sf).data());
+        switch (nc)
+        {
+            case 1: flatStencil<1, W>(G, b, st, acc); break;
+            case 2: flatStencil<2, W>(G, b, st, acc); break;
+            default: flatStencil<3, W>(G, b, st, acc);
+        }
+        for (int c = 0; c < nc; ++c) out[q*nc + c] = acc[c];
     }
 }
+
+#ifdef MBA_WIDE_VECTORS
+/// The same compiled for AVX2 with FMA, in vectors of four doubles
+template <int D>
+MBA_WIDE_TARGET void flatSweepWide(const double* G, const indexBox<D>& b, int nc, double sf, const point<D>* u0,
+                                   std::size_t n, double* out)
+{
+    flatSweep<D, 4>(G, b, nc, sf, u0, n, out);
+}
+#endif
 
 } // namespace
 
@@ -979,7 +1088,25 @@ void multilevel<D>::fold()
     for (int k = 0; k <= m; ++k)
     {
         const indexBox<D> fb = evalNodeBox(k);
-        if (k == 0) G.assign(std::size_t(boxNodes<D>(fb))*nc_, 0.0);
+        if (k == 0)
+        {
+            // the affine approximation: cubic B-splines reproduce linear
+            // functions, node j (u = j - 1 in level units) taking the
+            // function's value there; refined with the levels (exactly)
+            G.assign(std::size_t(boxNodes<D>(fb))*nc_, 0.0);
+            index<D> n;
+            for (int d = 0; d < D; ++d) n[d] = fb.hi[d] - fb.lo[d] + 1;
+            forEachIndex<D>(fb, [&](const index<D>& j) {
+                std::int64_t g = 0;
+                double x[D];
+                for (int d = 0; d < D; ++d)
+                {
+                    g = g*n[d] + (j[d] - fb.lo[d]);
+                    x[d] = dom_.lo[d] + double(j[d] - 1)*dom_.h0;
+                }
+                affine_.addTo(x, &G[g*nc_]);
+            });
+        }
         else refine<D>(G, gb, fb, nc_, T);
         gb = fb;
         // + this level's coefficients in the box
@@ -1090,26 +1217,33 @@ void multilevel<D>::addLevels(const double* x, double* out, int nLevels) const
 template <int D>
 void multilevel<D>::evaluate(std::vector<double>& out) const
 {
-    out.assign(eval_.size*nc_, 0.0);
     if (flat_ < 0)
     {
+        out.assign(eval_.size*nc_, 0.0);
         for (std::size_t q = 0; q < eval_.size; ++q) addLevels(eval_[evalAt(q)], &out[evalAt(q)*nc_], report_.levels);
         return;
     }
-    // The lattices (the flat one, then the finer levels that have tiles at
-    // the point) point after point in evaluation order. In the points' own
-    // order the results are written in place; in curve order into sweep_,
-    // from which the points' own order then gathers them (the reads and
-    // writes of points and results stay in sequence)
+    // The flat lattice point after point in evaluation order, then the finer
+    // levels at the points that have tiles there. In the points' own order
+    // the results are written in place; in curve order into sweep_, from
+    // which the points' own order then gathers them (the reads and writes of
+    // points and results stay in sequence)
     const bool own = evalOrder_.empty();
+    out.resize(eval_.size*nc_);     // (every value is written below)
     if (!own) sweep_.resize(eval_.size*nc_);
+    double* dst = own ? out.data() : sweep_.data();
     const double sf = std::ldexp(1.0, flat_);
-    const stencilTiles<D>* deep = deepTiles_.data();
+#ifdef MBA_WIDE_VECTORS
+    if (wideVectors())
+        flatSweepWide<D>(flatPhi_.data(), flatBox_, nc_, sf, evalU0_.data(), eval_.size, dst);
+    else
+#endif
+        flatSweep<D, 2>(flatPhi_.data(), flatBox_, nc_, sf, evalU0_.data(), eval_.size, dst);
+
+    // + the finer levels, in a pass of their own over the points that have them
+    const stencilTiles<D>* tiles = deepTiles_.data();
     for (std::size_t q = 0; q < eval_.size; ++q)
     {
-        const point<D>& u0 = evalU0_[q];
-        double acc[3] = {0, 0, 0};
-        flatStencil<D>(flatPhi_.data(), flatBox_, nc_, stencil<D>(scaled<D>(u0, sf).data()), acc);
         int k = flat_ + 1;
         for (std::uint32_t m = deepLevels_[q]; m; m >>= 1, ++k)
         {
@@ -1117,27 +1251,15 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
             if (k < report_.levels)
             {
                 const level& L = *levels_[k];
-                evalStencil(L.phi.data(), nc_, *deep, stencil<D>(scaled<D>(u0, L.scale).data()), acc);
+                evalStencil(L.phi.data(), nc_, *tiles, stencil<D>(scaled<D>(evalU0_[q], L.scale).data()), &dst[q*nc_]);
             }
-            ++deep;
-        }
-        if (own)
-        {
-            double* o = &out[q*nc_];
-            affine_.addTo(eval_[q], o);
-            for (int c = 0; c < nc_; ++c) o[c] += acc[c];
-        }
-        else
-        {
-            for (int c = 0; c < nc_; ++c) sweep_[q*nc_ + c] = acc[c];
+            ++tiles;
         }
     }
     for (std::size_t i = 0; i < eval_.size && !own; ++i)
     {
-        double* o = &out[i*nc_];
-        affine_.addTo(eval_[i], o);
         const double* v = &sweep_[std::size_t(evalPos_[i])*nc_];
-        for (int c = 0; c < nc_; ++c) o[c] += v[c];
+        for (int c = 0; c < nc_; ++c) out[i*nc_ + c] = v[c];
     }
 }
 
@@ -1170,10 +1292,10 @@ std::vector<levelStats> multilevel<D>::stats() const
 template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
-    std::int64_t b = std::int64_t((residual_.capacity() + scratch_.capacity() + flatPhi_.capacity() + foldScratch_.capacity() + sweep_.capacity())*sizeof(double)
+    std::int64_t b = std::int64_t((residual_.capacity() + rr_.capacity() + scratch_.capacity() + flatPhi_.capacity() + foldScratch_.capacity() + sweep_.capacity())*sizeof(double)
         + active_.capacity() + mask_.capacity() + deepLevels_.capacity()*sizeof(std::uint32_t) + deepTiles_.capacity()*sizeof(stencilTiles<D>)
         + (ctrlOrder_.capacity() + evalOrder_.capacity() + evalPos_.capacity())*sizeof(std::uint32_t)
-        + (ctrlU0_.capacity() + evalU0_.capacity())*sizeof(point<D>) + stencils_.capacity()*sizeof(stencil<D>));
+        + (ctrlU0_.capacity() + evalU0_.capacity())*sizeof(point<D>) + (stencils_.capacity() + cubed_.capacity())*sizeof(stencil<D>));
     for (const auto& L : levels_) b += L->stats.bytes;
     return b;
 }

@@ -114,11 +114,14 @@ class multilevel
     std::size_t evalAt(std::size_t q) const { return evalOrder_.empty() ? q : evalOrder_[q]; }
     std::vector<point<D>> ctrlU0_, evalU0_; ///< level-0 local coordinates of the active control / evaluation points, in ctrlOrder_ / evalOrder_
     std::vector<stencil<D>> stencils_;  ///< a fit's control-point stencils at the current level
+    std::vector<stencil<D>> cubed_;     ///< the same with their weights cubed (for the scatter)
     std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_ (curve order only)
     mutable std::vector<double> sweep_; ///< evaluate()'s values in curve order (kept: no new pages per call)
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
-    /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed into
+    std::vector<double> rr_;            ///< a fit's r/sum(w^2) per control point x component at the current level
+    /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed, with
+    /// the affine approximation (reproduced exactly by its node values), into
     /// one plain, untiled lattice over the level-flat_ nodes that the planned
     /// evaluation points' stencils touch (flatBox_), so that most points cost
     /// one contiguous stencil; flat_ is the finest level whose box has at most

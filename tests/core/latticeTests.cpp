@@ -78,6 +78,29 @@ void checkKernels(unsigned seed)
             double diff = 0;
             for (std::size_t j = 0; j < a.size(); ++j) diff = std::max(diff, std::abs(a[j] - b[j]));
             REQUIRE(diff <= 1e-15);
+
+            // A run of points in the same cell (the same stencil nodes), up
+            // to a few of scatterRun's chunks long
+            const int nRun = 1 + int(rng() % 40);
+            std::vector<stencil<D>> run;
+            std::vector<double> rs;
+            for (int j = 0; j < nRun; ++j)
+            {
+                point<D> v;
+                for (int d = 0; d < D; ++d) v[d] = double(st.base[d]) + 0.4999*(U(rng) + 1);
+                run.emplace_back(v.data());
+                for (int k = 0; k < NC; ++k) rs.push_back(U(rng));
+            }
+            std::fill(a.begin(), a.end(), 0.0);
+            std::fill(b.begin(), b.end(), 0.0);
+            detail::scatterRun<D, NC>(a.data(), tid, run.data(), rs.data(), nRun);
+            for (int j = 0; j < nRun; ++j)
+                eachNode(run[j], [&](std::int64_t id, int n, double w) {
+                    for (int k = 0; k < NC; ++k) b[(id*npt + n)*NC + k] += w*rs[j*NC + k];
+                });
+            diff = 0;
+            for (std::size_t j = 0; j < a.size(); ++j) diff = std::max(diff, std::abs(a[j] - b[j]));
+            REQUIRE(diff <= 1e-14);
         }
     REQUIRE(checked > (1 << (2*D)));
 }
@@ -86,7 +109,13 @@ void checkKernels(unsigned seed)
 
 TEST_CASE("tile-row stencil kernels equal a node-by-node reference", "[core][lattice]")
 {
+    // the two-double kernels and, where the processor has AVX2 and FMA, the
+    // four-double ones (wideVectors)
     const unsigned seed = GENERATE(1u, 2u, 3u);
+    const bool wide = GENERATE(false, true);
+    const bool was = useWideVectors(wide);
+    INFO("wide vectors " << wideVectors());
     SECTION("2D") { checkKernels<2, 1>(seed); checkKernels<2, 2>(seed); checkKernels<2, 3>(seed); }
     SECTION("3D") { checkKernels<3, 1>(seed); checkKernels<3, 2>(seed); checkKernels<3, 3>(seed); }
+    useWideVectors(was);
 }
