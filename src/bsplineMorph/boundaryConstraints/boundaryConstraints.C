@@ -20,6 +20,8 @@ License
 #include "syncTools.H"
 #include "polyMesh.H"
 #include "facePointPatch.H"
+#include "emptyPointPatch.H"
+#include "bitSet.H"
 #include "OStringStream.H"
 #include "IStringStream.H"
 #include "HashOps.H"
@@ -86,6 +88,16 @@ Foam::boundaryConstraints::boundaryConstraints
         owned_[pointi] = owner[pointi] == Pstream::myProcNo();
     }
 
+    bitSet onPatch(mesh.nPoints());
+    for (const pointPatch& pp : pMesh_.boundary())
+    {
+        if (!isA<emptyPointPatch>(pp))
+        {
+            onPatch.set(pp.meshPoints());
+        }
+    }
+    boundaryPoints_ = onPatch.sortedToc();
+
     update(pointDisplacement);
 }
 
@@ -101,13 +113,24 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     // The per-point arrays keep their storage from step to step (no new
     // pages for the mesh-sized arrays at every step)
     labelList& fixed = fixedSync_;
-    fixed.setSize(nPoints);
-    fixed = 0;
-    value_.setSize(nPoints);
-    value_ = Zero;
+    if (fixed.size() != nPoints)
+    {
+        fixed.setSize(nPoints);
+        fixed = 0;
+        fixed_.setSize(nPoints);
+        fixed_ = false;
+        value_.setSize(nPoints);
+        value_ = Zero;
+        slide_.setSize(nPoints);
+        slide_ = pointConstraint();
+    }
+    for (const label pointi : boundaryPoints_)
+    {
+        fixed[pointi] = 0;
+        value_[pointi] = Zero;
+        slide_[pointi] = pointConstraint();
+    }
     wordHashSet badPatches;
-    slide_.setSize(nPoints);
-    slide_ = pointConstraint();
 
     forAll(pointDisplacement.boundaryField(), patchi)
     {
@@ -203,8 +226,7 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     syncTools::syncPointList(mesh, value_, maxMagSqrEqOp<vector>(), vector::zero);
     syncTools::syncPointList(mesh, slide_, combineConstraintsEqOp(), pointConstraint());
 
-    fixed_.setSize(nPoints);
-    forAll(fixed, pointi)
+    for (const label pointi : boundaryPoints_)
     {
         fixed_[pointi] = fixed[pointi] != 0;
     }
@@ -219,7 +241,7 @@ void Foam::boundaryConstraints::collectControls()
     DynamicList<label> ctrl, proj;
     mask_.clear();
     values_.clear();
-    forAll(fixed_, pointi)
+    for (const label pointi : boundaryPoints_)
     {
         bool m[3] = {false, false, false};
         if (fixed_[pointi])
@@ -267,7 +289,8 @@ Foam::boundaryConstraints::boundaryConstraints
     fixed_(bc.fixed_),
     value_(bc.value_),
     slide_(bc.slide_),
-    owned_(bc.owned_)
+    owned_(bc.owned_),
+    boundaryPoints_(bc.boundaryPoints_)
 {
     for (const label pointi : bc.projected_)
     {
@@ -292,8 +315,7 @@ Foam::label Foam::boundaryConstraints::nProjectedGlobal() const
 
 void Foam::boundaryConstraints::constrain(vectorField& displacement) const
 {
-    const Vector<label>& solD = pMesh_().solutionD();
-    forAll(displacement, pointi)
+    for (const label pointi : boundaryPoints_)
     {
         vector& d = displacement[pointi];
         if (fixed_[pointi])
@@ -315,9 +337,13 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
                 d = slide_[pointi].constrainDisplacement(d);
             }
         }
-        for (direction c = 0; c < 3; ++c)
+    }
+    const Vector<label>& solD = pMesh_().solutionD();
+    for (direction c = 0; c < 3; ++c)
+    {
+        if (solD[c] != 1)
         {
-            if (solD[c] != 1) d[c] = 0;
+            displacement.replace(c, scalar(0));
         }
     }
 }

@@ -71,6 +71,8 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
     vol = 0;
     forAll(faces, facei)
     {
+        // (a face's labels lie elsewhere: asked for some faces ahead)
+        if (facei + 32 < faces.size()) __builtin_prefetch(faces[facei + 32].cdata());
         const face& f = faces[facei];
         const point& p0 = points[f[0]];
         vector sum, area;
@@ -234,14 +236,17 @@ void Foam::interpolatingMotionSolver::solve()
     }
 
     vectorField& displacement = displacement_;
+    // (every point is set below: the interpolated ones in the solution
+    // directions, the fixed ones by constrain, which also zeroes the
+    // directions a 2D mesh does not solve for)
     displacement.setSize(points0().size());
-    displacement = Zero;
     slot_ = 0;
     if (constraintsPtr_->nControlGlobal() == 0)
     {
         WarningInFunction
             << "No control points: no patch of pointDisplacement fixes a value"
             << " or slides; the mesh keeps its initial points" << endl;
+        displacement = Zero;
         clearPlan();
     }
     else
@@ -298,9 +303,14 @@ void Foam::interpolatingMotionSolver::solve()
     // the constrained interpolant: slip conditions would re-project their
     // points with their own point normals, which on a rank hold only that
     // rank's faces and so differ between decompositions
+    // (the conditions write at their patches' points only: those are restored)
     pointDisplacement_.primitiveFieldRef() = displacement;
     pointDisplacement_.correctBoundaryConditions();
-    pointDisplacement_.primitiveFieldRef() = displacement;
+    vectorField& pd = pointDisplacement_.primitiveFieldRef();
+    for (const label pointi : constraintsPtr_->boundaryPoints())
+    {
+        pd[pointi] = displacement[pointi];
+    }
 
     if (!summary.empty())
     {
