@@ -1150,7 +1150,7 @@ void multilevel<D>::fold()
     const std::pair<int, int> key(int(levels_.size()), flat_);
     if (key == deepKey_) return;
     precondition(int(levels_.size()) - flat_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
-    deepLevels_.assign(eval_.size, 0);
+    deepLevels_.clear();
     deepTiles_.clear();
     std::vector<std::vector<std::uint8_t>> read(levels_.size());
     for (int k = flat_ + 1; k < int(levels_.size()); ++k)
@@ -1159,6 +1159,7 @@ void multilevel<D>::fold()
     for (std::size_t q = 0; q < eval_.size; ++q)
     {
         const point<D>& u0 = evalU0_[q];
+        std::uint32_t m = 0;
         for (int k = flat_ + 1; k < int(levels_.size()); ++k)
         {
             const level& L = *levels_[k];
@@ -1169,11 +1170,13 @@ void multilevel<D>::fold()
             double w[3] = {0, 0, 0};
             evalStencil(L.invOmega.data(), nw_, tid, st, w);
             if (!(w[0] + w[1] + w[2] > 0)) continue;
-            deepLevels_[q] |= std::uint32_t(1) << (k - flat_ - 1);
+            m |= std::uint32_t(1) << (k - flat_ - 1);
             deepTiles_.push_back(tid);
             if (!read[k].empty()) for (const std::int32_t id : tid) if (id >= 0) read[k][id] = 1;
         }
+        if (m) deepLevels_.emplace_back(std::uint32_t(q), m);
     }
+    deepLevels_.shrink_to_fit();
     deepTiles_.shrink_to_fit();
     deepKey_ = key;
 
@@ -1242,10 +1245,11 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
 
     // + the finer levels, in a pass of their own over the points that have them
     const stencilTiles<D>* tiles = deepTiles_.data();
-    for (std::size_t q = 0; q < eval_.size; ++q)
+    for (const auto& qm : deepLevels_)
     {
+        const std::size_t q = qm.first;
         int k = flat_ + 1;
-        for (std::uint32_t m = deepLevels_[q]; m; m >>= 1, ++k)
+        for (std::uint32_t m = qm.second; m; m >>= 1, ++k)
         {
             if (!(m & 1)) continue;
             if (k < report_.levels)
@@ -1293,7 +1297,7 @@ template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
     std::int64_t b = std::int64_t((residual_.capacity() + rr_.capacity() + scratch_.capacity() + flatPhi_.capacity() + foldScratch_.capacity() + sweep_.capacity())*sizeof(double)
-        + active_.capacity() + mask_.capacity() + deepLevels_.capacity()*sizeof(std::uint32_t) + deepTiles_.capacity()*sizeof(stencilTiles<D>)
+        + active_.capacity() + mask_.capacity() + deepLevels_.capacity()*sizeof(deepLevels_[0]) + deepTiles_.capacity()*sizeof(stencilTiles<D>)
         + (ctrlOrder_.capacity() + evalOrder_.capacity() + evalPos_.capacity())*sizeof(std::uint32_t)
         + (ctrlU0_.capacity() + evalU0_.capacity())*sizeof(point<D>) + (stencils_.capacity() + cubed_.capacity())*sizeof(stencil<D>));
     for (const auto& L : levels_) b += L->stats.bytes;

@@ -130,10 +130,11 @@ class multilevel
     point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
     indexBox<D> flatBox_;
     std::vector<double> flatPhi_, foldScratch_;
-    /// Per evaluation point, in evalOrder_: the levels above flat_ with
-    /// coefficients at its stencil (a node with omega > 0; phi is 0 at the
-    /// others), bit j for level flat_ + 1 + j
-    std::vector<std::uint32_t> deepLevels_;
+    /// The evaluation points (positions in evalOrder_, ascending) where levels
+    /// above flat_ have coefficients at the point's stencil (a node with
+    /// omega > 0; phi is 0 at the others), and those levels: bit j for level
+    /// flat_ + 1 + j
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> deepLevels_;
     /// Their stencils' tiles, point after point in evalOrder_
     std::vector<stencilTiles<D>> deepTiles_;
     std::pair<int, int> deepKey_{-1, -1}; ///< (levels built, flat_) deepLevels_ was found for

@@ -235,11 +235,11 @@ void Foam::interpolatingMotionSolver::solve()
         constraintsPtr_.reset(new boundaryConstraints(pointDisplacement_));
     }
 
-    vectorField& displacement = displacement_;
-    // (every point is set below: the interpolated ones in the solution
-    // directions, the fixed ones by constrain, which also zeroes the
-    // directions a 2D mesh does not solve for)
-    displacement.setSize(points0().size());
+    // The displacement is worked out in pointDisplacement's own values (the
+    // conditions have been read): every point is set below, the interpolated
+    // ones in the solution directions, the fixed ones by constrain, which also
+    // zeroes the directions a 2D mesh does not solve for
+    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     slot_ = 0;
     if (constraintsPtr_->nControlGlobal() == 0)
     {
@@ -302,14 +302,18 @@ void Foam::interpolatingMotionSolver::solve()
     // Evaluate the conditions (fixed values, processor patches), then keep
     // the constrained interpolant: slip conditions would re-project their
     // points with their own point normals, which on a rank hold only that
-    // rank's faces and so differ between decompositions
-    // (the conditions write at their patches' points only: those are restored)
-    pointDisplacement_.primitiveFieldRef() = displacement;
-    pointDisplacement_.correctBoundaryConditions();
-    vectorField& pd = pointDisplacement_.primitiveFieldRef();
-    for (const label pointi : constraintsPtr_->boundaryPoints())
+    // rank's faces and so differ between decompositions (the conditions
+    // write at their patches' points only: those are restored)
+    const labelList& bp = constraintsPtr_->boundaryPoints();
+    boundaryValues_.setSize(bp.size());
+    forAll(bp, i)
     {
-        pd[pointi] = displacement[pointi];
+        boundaryValues_[i] = displacement[bp[i]];
+    }
+    pointDisplacement_.correctBoundaryConditions();
+    forAll(bp, i)
+    {
+        displacement[bp[i]] = boundaryValues_[i];
     }
 
     if (!summary.empty())
