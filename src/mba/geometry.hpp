@@ -72,6 +72,16 @@ void forEachIndex(const indexBox<D>& b, F&& f)
     }
 }
 
+/// Position of index i among the box's indices in the order of forEachIndex
+/// (the last direction fastest)
+template <int D>
+inline std::int64_t boxIndex(const indexBox<D>& b, const index<D>& i)
+{
+    std::int64_t g = 0;
+    for (int d = 0; d < D; ++d) g = g*(b.hi[d] - b.lo[d] + 1) + (i[d] - b.lo[d]);
+    return g;
+}
+
 /// Bounding box in space
 template <int D> struct box
 {

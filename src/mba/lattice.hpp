@@ -187,13 +187,19 @@ bool findTiles(const tileLayout<D>& L, const stencil<D>& st, stencilTiles<D>& ti
 #endif
 
 namespace detail {
-inline bool& wideFlag()
+/// Whether the processor runs the kernels compiled for AVX2 with FMA
+inline bool cpuHasWideVectors()
 {
 #ifdef MBA_WIDE_VECTORS
-    static bool on = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 #else
-    static bool on = false;
+    return false;
 #endif
+}
+
+inline bool& wideFlag()
+{
+    static bool on = cpuHasWideVectors();
     return on;
 }
 }
@@ -208,11 +214,7 @@ inline bool wideVectors() { return detail::wideFlag(); }
 inline bool useWideVectors(bool on)
 {
     const bool was = detail::wideFlag();
-#ifdef MBA_WIDE_VECTORS
-    detail::wideFlag() = on && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-#else
-    (void)on;
-#endif
+    detail::wideFlag() = on && detail::cpuHasWideVectors();
     return was;
 }
 
@@ -345,6 +347,25 @@ void visitStencil(const stencilTiles<D>& tid, const stencil<D>& st, F&& f)
     });
 }
 
+/// Row n (a node of the tile where a tile row starts) of tile id, NC values
+/// a node; absent where id < 0: then the given stand-in (zeros to read, a
+/// sink to write)
+template <int D, int NC, class T>
+inline __attribute__((always_inline)) T* tileRow(T* phi, std::int32_t id, int n, T* absent)
+{
+    return id >= 0 ? phi + (std::int64_t(id)*tileLayout<D>::nodesPerTile + n)*NC : absent;
+}
+
+/// u[(first + c)*NC + k] = w[c] r[k] for the 4 nodes c along the last
+/// direction: a stencil row's values from a point's (NC values) and its
+/// last-direction weights w, from node first of u on
+template <int NC>
+inline __attribute__((always_inline)) void lastDirection(const double* w, const double* r, int first, double* u)
+{
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < NC; ++k) u[(first + c)*NC + k] = w[c]*r[k];
+}
+
 /// A stencil row whose last-direction nodes start at node OZ of a tile row
 /// (NC values a node, the tile row at p0) and go on at node 0 of the next
 /// tile's row (p1, used when OZ > 0): the 4 nodes' values in stencil order
@@ -407,12 +428,9 @@ inline __attribute__((always_inline)) void storeSplit(double* p0, double* p1, do
 template <int D, int NC, int OZ>
 void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st, double* out)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    constexpr int R = 4*NC;
     static constexpr double zero[R] = {};
-    auto row = [phi, &tid](int t, int n) {
-        const std::int32_t id = tid[t];
-        return id >= 0 ? phi + (std::int64_t(id)*npt + n)*NC : zero;
-    };
+    auto row = [phi, &tid](int t, int n) { return tileRow<D, NC>(phi, tid[t], n, zero); };
     vrow<R> acc = {};
     forRows(st, [&](int t, int n, double w) {
         axpy<R>(acc, w, loadSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : zero));
@@ -430,11 +448,10 @@ template <int D, int NC, int OZ>
 MBA_WIDE_TARGET void sweepStencilWide(const double* phi, const stencilTiles<D>& tid, const stencil<D>& st,
                                       double* out)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    constexpr int R = 4*NC;
     static constexpr double zero[R] = {};
     auto row = [phi, &tid](int t, int n) __attribute__((always_inline)) {
-        const std::int32_t id = tid[t];
-        return id >= 0 ? phi + (std::int64_t(id)*npt + n)*NC : zero;
+        return tileRow<D, NC>(phi, tid[t], n, zero);
     };
     vrow<R, 4> a[2] = {};
     int i = 0;
@@ -472,15 +489,11 @@ template <int D, int NC, int OZ, put P>
 void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>& st, const double* r,
                     const bool* on)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    constexpr int R = 4*NC;
     double u[R], sink[R] = {};
-    for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < NC; ++k) u[c*NC + k] = st.w[D - 1][c]*r[k];
+    lastDirection<NC>(st.w[D - 1], r, 0, u);
     const vrow<R> v = vrow<R>::load(u);
-    auto row = [delta, &tid, &sink](int t, int n) {
-        const std::int32_t id = tid[t];
-        return id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
-    };
+    auto row = [delta, &tid, &sink](int t, int n) { return tileRow<D, NC>(delta, tid[t], n, sink); };
     forRows(st, [&](int t, int n, double w) {
         if (P == put::add) addSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : sink, w, v);
         else storeSplit<NC, OZ, P>(row(t, n), OZ ? row(t + 1, n) : sink, w, v, on);
@@ -495,14 +508,12 @@ template <int D, int NC, int OZ>
 MBA_WIDE_TARGET void scatterStencilWide(double* delta, const stencilTiles<D>& tid, const stencil<D>& st,
                                         const double* r)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC;
+    constexpr int R = 4*NC;
     double u[2*R] = {}, sink[R];
-    for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < NC; ++k) u[(OZ + c)*NC + k] = st.w[D - 1][c]*r[k];
+    lastDirection<NC>(st.w[D - 1], r, OZ, u);
     const vrow<R, 4> ua = vrow<R, 4>::load(u), ub = vrow<R, 4>::load(u + R);
     auto addRow = [delta, &tid, &sink](int t, int n, double w, const vrow<R, 4>& v) __attribute__((always_inline)) {
-        const std::int32_t id = tid[t];
-        double* p = id >= 0 ? delta + (std::int64_t(id)*npt + n)*NC : sink;
+        double* p = tileRow<D, NC>(delta, tid[t], n, sink);
         vrow<R, 4> x = vrow<R, 4>::load(p);
         axpy<R, 4>(x, w, v);
         x.store(p);
@@ -522,7 +533,7 @@ template <int D, int NC, int OZ>
 MBA_WIDE_TARGET void scatterRunWide(double* delta, const stencilTiles<D>& tid, const stencil<D>* st,
                                     const double* r, std::size_t n)
 {
-    constexpr int npt = tileLayout<D>::nodesPerTile, R = 4*NC, H = OZ ? 2 : 1;
+    constexpr int R = 4*NC, H = OZ ? 2 : 1;
     constexpr int nRows = D == 3 ? 16 : 4;
     constexpr std::size_t chunk = 16;
     double sink[R];
@@ -540,8 +551,7 @@ MBA_WIDE_TARGET void scatterRunWide(double* delta, const stencilTiles<D>& tid, c
         {
             const stencil<D>& sj = st[p0 + j];
             double uj[2*R] = {};
-            for (int c = 0; c < 4; ++c)
-                for (int k = 0; k < NC; ++k) uj[(OZ + c)*NC + k] = sj.w[D - 1][c]*r[(p0 + j)*NC + k];
+            lastDirection<NC>(sj.w[D - 1], r + (p0 + j)*NC, OZ, uj);
             for (int h = 0; h < H; ++h) u[j][h] = vrow<R, 4>::load(uj + h*R);
             int i = 0;
             forRows(sj, [&](int, int, double wr) { w[j][i++] = wr; });
@@ -559,8 +569,7 @@ MBA_WIDE_TARGET void scatterRunWide(double* delta, const stencilTiles<D>& tid, c
             for (int e = 0; e < 2; ++e)
                 for (int h = 0; h < H; ++h)
                 {
-                    const std::int32_t id = tid[rowT[i + e] + h];
-                    double* p = id >= 0 ? delta + (std::int64_t(id)*npt + rowN[i + e])*NC : sink;
+                    double* p = tileRow<D, NC>(delta, tid[rowT[i + e] + h], rowN[i + e], sink);
                     vrow<R, 4> x = vrow<R, 4>::load(p);
                     add(x, acc[e][h]);
                     x.store(p);

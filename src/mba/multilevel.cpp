@@ -327,9 +327,10 @@ template <int D>
 multilevel<D>::~multilevel() = default;
 
 template <int D>
-inline __attribute__((always_inline)) stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q) const
+inline __attribute__((always_inline)) stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q,
+                                                                          bool cubed) const
 {
-    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data());
+    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data(), cubed);
 }
 
 template <int D>
@@ -659,9 +660,8 @@ void multilevel<D>::applyLevel(level& L)
     cubed_.resize(L.separated ? 0 : nq);
     for (std::size_t q = 0; q < nq; ++q)
     {
-        const point<D> u = scaled<D>(ctrlU0_[q], L.scale);
-        stencils_[q] = stencil<D>(u.data());
-        if (!L.separated) cubed_[q] = stencil<D>(u.data(), true);
+        stencils_[q] = ctrlStencil(L, q);
+        if (!L.separated) cubed_[q] = ctrlStencil(L, q, true);
     }
     // r/sum(w^2) per point
     std::vector<double>& rr = L.separated ? L.rr : rr_;
@@ -682,21 +682,18 @@ void multilevel<D>::applyLevel(level& L)
                 scatterSeparated<D>(L.phi.data(), nc_, L.ctrlView[q], stencils_[q], &rr[q*nc_], constrained(ctrlOrder_[q], on));
         }
     }
-    else if (!L.ghosts)
+    else
     {
-        // runs of points with the same stencil nodes at once (coarse levels;
-        // short runs point after point)
+        // Runs of points with the same stencil nodes at once (coarse levels);
+        // short runs point after point, and every point at a level with
+        // ghosts, as the ranks holding them as ghosts form their sums
+        const std::size_t shortest = L.ghosts ? nq + 1 : minRun;
         for (std::size_t q = 0, e; q < nq; q = e)
         {
             for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
-            if (e - q >= minRun) scatterRun<D>(L.phi.data(), nc_, L.ctrlView[q], &cubed_[q], &rr[q*nc_], e - q);
+            if (e - q >= shortest) scatterRun<D>(L.phi.data(), nc_, L.ctrlView[q], &cubed_[q], &rr[q*nc_], e - q);
             else for (std::size_t j = q; j < e; ++j) scatter<D>(L.phi.data(), nc_, L.ctrlView[j], cubed_[j], &rr[j*nc_]);
         }
-    }
-    else
-    {
-        // (point after point, as the ranks holding them as ghosts do)
-        for (std::size_t q = 0; q < nq; ++q) scatter<D>(L.phi.data(), nc_, L.ctrlView[q], cubed_[q], &rr[q*nc_]);
     }
     L.complete = !L.separated;
 
@@ -944,10 +941,10 @@ void refine(std::vector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb
 
 /// Node i of a plain lattice over the nodes of box b (the last direction
 /// fastest, nc values a node)
-inline const double* flatNode(const double* G, const indexBox<3>& b, const index<3>& i, int nc)
+template <int D>
+inline const double* flatNode(const double* G, const indexBox<D>& b, const index<D>& i, int nc)
 {
-    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
-    return G + (((i[0] - b.lo[0])*n1 + (i[1] - b.lo[1]))*n2 + (i[2] - b.lo[2]))*nc;
+    return G + boxIndex<D>(b, i)*nc;
 }
 
 /// Adds the value at a stencil of a plain lattice (nodes of box b, the last
@@ -960,7 +957,7 @@ inline __attribute__((always_inline)) void flatStencil(const double* G, const in
                                                        const stencil<3>& st, double* out)
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
-    const double* p0 = flatNode(G, b, st.base, NC);
+    const double* p0 = flatNode<3>(G, b, st.base, NC);
     detail::vrow<4*NC, W> r[2] = {};
     for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
@@ -973,7 +970,7 @@ inline __attribute__((always_inline)) void flatStencil(const double* G, const in
                                                        const stencil<2>& st, double* out)
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
-    const double* p0 = G + ((st.base[0] - b.lo[0])*n1 + (st.base[1] - b.lo[1]))*NC;
+    const double* p0 = flatNode<2>(G, b, st.base, NC);
     detail::vrow<4*NC, W> r[2] = {};
     for (int a = 0; a < 4; ++a) detail::axpy<4*NC, W>(r[a & 1], st.w[0][a], p0 + a*n1*NC);
     detail::add(r[0], r[1]);
@@ -988,7 +985,7 @@ inline __attribute__((always_inline)) void prefetchRows(const double* G, const i
 {
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
     const index<3> base{{std::int64_t(u[0]), std::int64_t(u[1]), std::int64_t(u[2])}};  // as stencil's
-    const double* p0 = flatNode(G, b, base, nc);
+    const double* p0 = flatNode<3>(G, b, base, nc);
     for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 4; ++c)
         {
@@ -1094,46 +1091,33 @@ void multilevel<D>::fold()
             // functions, node j (u = j - 1 in level units) taking the
             // function's value there; refined with the levels (exactly)
             G.assign(std::size_t(boxNodes<D>(fb))*nc_, 0.0);
-            index<D> n;
-            for (int d = 0; d < D; ++d) n[d] = fb.hi[d] - fb.lo[d] + 1;
             forEachIndex<D>(fb, [&](const index<D>& j) {
-                std::int64_t g = 0;
                 double x[D];
-                for (int d = 0; d < D; ++d)
-                {
-                    g = g*n[d] + (j[d] - fb.lo[d]);
-                    x[d] = dom_.lo[d] + double(j[d] - 1)*dom_.h0;
-                }
-                affine_.addTo(x, &G[g*nc_]);
+                for (int d = 0; d < D; ++d) x[d] = dom_.lo[d] + double(j[d] - 1)*dom_.h0;
+                affine_.addTo(x, &G[boxIndex<D>(fb, j)*nc_]);
             });
         }
         else refine<D>(G, gb, fb, nc_, T);
         gb = fb;
         // + this level's coefficients in the box
         const level& L = *levels_[k];
-        index<D> n;
-        for (int d = 0; d < D; ++d) n[d] = gb.hi[d] - gb.lo[d] + 1;
         for (std::int64_t id = 0; id < L.view.size(); ++id)
         {
             const index<D> t = L.view.coord(L.view.keyOf(id));
-            indexBox<D> nb;
+            indexBox<D> tb, nb;     // the tile's nodes; those in the box
             bool inside = true;
             for (int d = 0; d < D; ++d)
             {
-                nb.lo[d] = std::max(t[d]*tileEdge, gb.lo[d]);
-                nb.hi[d] = std::min(t[d]*tileEdge + tileEdge - 1, gb.hi[d]);
+                tb.lo[d] = t[d]*tileEdge;
+                tb.hi[d] = tb.lo[d] + tileEdge - 1;
+                nb.lo[d] = std::max(tb.lo[d], gb.lo[d]);
+                nb.hi[d] = std::min(tb.hi[d], gb.hi[d]);
                 inside = inside && nb.lo[d] <= nb.hi[d];
             }
             if (!inside) continue;
             forEachIndex<D>(nb, [&](const index<D>& j) {
-                std::int64_t g = 0, q = 0;
-                for (int d = 0; d < D; ++d)
-                {
-                    g = g*n[d] + (j[d] - gb.lo[d]);
-                    q = q*tileEdge + (j[d] - t[d]*tileEdge);
-                }
-                const double* p = &L.phi[(id*npt + q)*nc_];
-                double* o = &G[g*nc_];
+                const double* p = &L.phi[(id*npt + boxIndex<D>(tb, j))*nc_];
+                double* o = &G[boxIndex<D>(gb, j)*nc_];
                 for (int c = 0; c < nc_; ++c) o[c] += p[c];
             });
         }

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 #include "lattice.hpp"
+#include "testData.hpp"
 
 #include <cmath>
 #include <random>
@@ -17,14 +18,14 @@ void checkKernels(unsigned seed)
     constexpr int npt = tileLayout<D>::nodesPerTile;
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> U(-1, 1);
-    index<D> nodes;
+    mba::index<D> nodes;
     nodes.fill(4*tileEdge);
     tileLayout<D> L;
     L.init(nodes, false);
     indexBox<D> tiles;
     tiles.lo.fill(0);
     tiles.hi.fill(3);
-    forEachIndex<D>(tiles, [&](const index<D>& t) { if (U(rng) < 0.4) L.findOrInsert(t); });
+    forEachIndex<D>(tiles, [&](const mba::index<D>& t) { if (U(rng) < 0.4) L.findOrInsert(t); });
     std::vector<double> phi(L.size()*npt*NC);
     for (double& x : phi) x = U(rng);
 
@@ -33,8 +34,8 @@ void checkKernels(unsigned seed)
         indexBox<D> a;
         a.lo.fill(0);
         a.hi.fill(3);
-        forEachIndex<D>(a, [&](const index<D>& i) {
-            index<D> t;
+        forEachIndex<D>(a, [&](const mba::index<D>& i) {
+            mba::index<D> t;
             int n = 0;
             double w = 1;
             for (int d = 0; d < D; ++d)
@@ -112,10 +113,8 @@ TEST_CASE("tile-row stencil kernels equal a node-by-node reference", "[core][lat
     // the two-double kernels and, where the processor has AVX2 and FMA, the
     // four-double ones (wideVectors)
     const unsigned seed = GENERATE(1u, 2u, 3u);
-    const bool wide = GENERATE(false, true);
-    const bool was = useWideVectors(wide);
+    const bsmTest::vectorWidth width(GENERATE(false, true));
     INFO("wide vectors " << wideVectors());
     SECTION("2D") { checkKernels<2, 1>(seed); checkKernels<2, 2>(seed); checkKernels<2, 3>(seed); }
     SECTION("3D") { checkKernels<3, 1>(seed); checkKernels<3, 2>(seed); checkKernels<3, 3>(seed); }
-    useWideVectors(was);
 }

@@ -178,10 +178,9 @@ TEST_CASE("planned evaluation (flat lattice + finer levels) equals the sum of th
 {
     // with the two-double kernels and, where the processor has AVX2 and FMA,
     // the four-double ones; 1 to 3 components
-    const bool wide = wideVectors();
     for (const bool w : {false, true})
     {
-        useWideVectors(w);
+        const bsmTest::vectorWidth width(w);
         INFO("wide vectors " << wideVectors());
         for (int nc = 1; nc <= 3; ++nc)
         {
@@ -190,7 +189,6 @@ TEST_CASE("planned evaluation (flat lattice + finer levels) equals the sum of th
             flatEqualsLevels<3>(nc);
         }
     }
-    useWideVectors(wide);
 }
 
 namespace {

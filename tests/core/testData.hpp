@@ -11,6 +11,15 @@
 
 namespace bsmTest {
 
+/// The kernels' vector width (mba::useWideVectors) for a scope, restored when
+/// the scope ends, also when a failed assertion ends it
+struct vectorWidth
+{
+    const bool was;
+    explicit vectorWidth(bool wide) : was(mba::useWideVectors(wide)) {}
+    ~vectorWidth() { mba::useWideVectors(was); }
+};
+
 template <int D>
 std::vector<mba::point<D>> randomPoints(std::size_t n, unsigned seed, double lo = 0, double hi = 1)
 {
