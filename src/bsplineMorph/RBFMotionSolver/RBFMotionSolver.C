@@ -76,14 +76,14 @@ template<int D>
 std::string Foam::RBFMotionSolver::interpolateD
 (
     std::vector<std::unique_ptr<rbf::interpolant<D>>>& rbf,
-    vectorField& displacement
+    std::vector<double>& result
 )
 {
     const boundaryConstraints& bc = constraints();
-    const labelList& dirs = bc.directions();
     const labelList& points = evalPoints();
     const mba::pointsView<D> eval(evalCoordinates(), std::size_t(points.size()));
     std::vector<double> values, out;
+    result.resize(D*points.size());
     label size = 0;
     scalar rcond = GREAT;
     try
@@ -96,7 +96,7 @@ std::string Foam::RBFMotionSolver::interpolateD
             rbf[k]->evaluate(eval, out);
             forAll(points, i)
             {
-                displacement[points[i]][dirs[k]] = out[i];
+                result[i*D + k] = out[i];
             }
             size = max(size, label(rbf[k]->stats().size));
             rcond = min(rcond, rbf[k]->stats().rcond);
@@ -201,13 +201,13 @@ void Foam::RBFMotionSolver::buildPlan()
 }
 
 
-std::string Foam::RBFMotionSolver::interpolate(vectorField& displacement)
+std::string Foam::RBFMotionSolver::interpolate(std::vector<double>& values)
 {
     if (!rbf3_[slot()].empty())
     {
-        return interpolateD(rbf3_[slot()], displacement);
+        return interpolateD(rbf3_[slot()], values);
     }
-    return interpolateD(rbf2_[slot()], displacement);
+    return interpolateD(rbf2_[slot()], values);
 }
 
 

@@ -124,11 +124,19 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
         slide_.setSize(nPoints);
         slide_ = pointConstraint();
     }
+    // (only what the last update set is reset: storing a pointConstraint at
+    // every boundary point cost more than the rest of the update together)
     for (const label pointi : boundaryPoints_)
     {
-        fixed[pointi] = 0;
-        value_[pointi] = Zero;
-        slide_[pointi] = pointConstraint();
+        if (fixed[pointi])
+        {
+            fixed[pointi] = 0;
+            value_[pointi] = Zero;
+        }
+        if (slide_[pointi].first())
+        {
+            slide_[pointi] = pointConstraint();
+        }
     }
     wordHashSet badPatches;
 

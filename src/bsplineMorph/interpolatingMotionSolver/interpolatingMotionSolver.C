@@ -143,6 +143,32 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
 }
 
 
+std::string Foam::interpolatingMotionSolver::interpolateInto
+(
+    vectorField& displacement
+)
+{
+    const std::string summary = interpolate(values_);
+    // The interpolated points' displacement (zero outside the solution
+    // directions) and their moved points, in one pass
+    const labelList& dirs = constraintsPtr_->directions();
+    const label nd = dirs.size();
+    const pointField& p0 = points0();
+    forAll(evalPoints_, i)
+    {
+        const label pointi = evalPoints_[i];
+        vector d(Zero);
+        for (label k = 0; k < nd; ++k)
+        {
+            d[dirs[k]] = values_[i*nd + k];
+        }
+        displacement[pointi] = d;
+        newPoints_[pointi] = p0[pointi] + d;
+    }
+    return summary;
+}
+
+
 void Foam::interpolatingMotionSolver::use(const label slot, const bool changed)
 {
     slot_ = slot;
@@ -236,10 +262,13 @@ void Foam::interpolatingMotionSolver::solve()
     }
 
     // The displacement is worked out in pointDisplacement's own values (the
-    // conditions have been read): every point is set below, the interpolated
-    // ones in the solution directions, the fixed ones by constrain, which also
-    // zeroes the directions a 2D mesh does not solve for
+    // conditions have been read), and the moved points beside it: every point
+    // is set below, the interpolated ones by interpolateInto (zero outside the
+    // solution directions), the fixed ones by constrain, which also zeroes the
+    // directions a 2D mesh does not solve for
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
+    const pointField& p0 = points0();
+    newPoints_.setSize(p0.size());
     slot_ = 0;
     if (constraintsPtr_->nControlGlobal() == 0)
     {
@@ -247,12 +276,13 @@ void Foam::interpolatingMotionSolver::solve()
             << "No control points: no patch of pointDisplacement fixes a value"
             << " or slides; the mesh keeps its initial points" << endl;
         displacement = Zero;
+        newPoints_ = p0;
         clearPlan();
     }
     else
     {
         use(0, changed);
-        summary = interpolate(displacement);
+        summary = interpolateInto(displacement);
 
         // Sliding planes not along the axes: project, then fit again with
         // the projected points as control points, so that the interpolant
@@ -268,15 +298,14 @@ void Foam::interpolatingMotionSolver::solve()
              || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
             refitPtr_ = std::move(refit);
             use(1, refitChanged);
-            summary += "; re-fit with the projected sliding points: " + interpolate(displacement);
+            summary += "; re-fit with the projected sliding points: " + interpolateInto(displacement);
             slot_ = 0;
         }
     }
+    // The points the conditions fix or constrain (the interpolated ones
+    // moved already)
     constraintsPtr_->constrain(displacement);
-
-    const pointField& p0 = points0();
-    newPoints_.setSize(p0.size());
-    forAll(newPoints_, pointi)
+    for (const label pointi : constraintsPtr_->boundaryPoints())
     {
         newPoints_[pointi] = p0[pointi] + displacement[pointi];
     }

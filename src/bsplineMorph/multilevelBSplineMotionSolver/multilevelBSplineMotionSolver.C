@@ -146,33 +146,21 @@ template<int D>
 std::string Foam::multilevelBSplineMotionSolver::morph
 (
     mba::multilevel<D>& plan,
-    vectorField& displacement
+    std::vector<double>& values
 )
 {
-    const boundaryConstraints& bc = constraints();
-    const labelList& dirs = bc.directions();
-    std::vector<double>& out = values_;
     scalar evalSeconds = 0;
     try
     {
-        plan.fit(bc.values());
+        plan.fit(constraints().values());
         const clockTime timer;
-        plan.evaluate(out);
+        plan.evaluate(values);
         evalSeconds = timer.elapsedTime();
     }
     catch (const std::exception& e)
     {
         FatalErrorInFunction
             << "Multilevel B-spline fit failed: " << e.what() << exit(FatalError);
-    }
-    const labelList& points = evalPoints();
-    forAll(points, i)
-    {
-        vector& d = displacement[points[i]];
-        for (label k = 0; k < D; ++k)
-        {
-            d[dirs[k]] = out[i*D + k];
-        }
     }
 
     const mba::fitReport& r = plan.report();
@@ -252,14 +240,14 @@ Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
 
 std::string Foam::multilevelBSplineMotionSolver::interpolate
 (
-    vectorField& displacement
+    std::vector<double>& values
 )
 {
     if (plan3_[slot()])
     {
-        return morph(*plan3_[slot()], displacement);
+        return morph(*plan3_[slot()], values);
     }
-    return morph(*plan2_[slot()], displacement);
+    return morph(*plan2_[slot()], values);
 }
 
 
