@@ -310,7 +310,9 @@ void Foam::interpolatingMotionSolver::solve()
         newPoints_[pointi] = p0[pointi] + displacement[pointi];
     }
     twoDCorrectPoints(newPoints_);
+    const clockTime checkTimer;
     const label nInverted = nInvertedCells(newPoints_);
+    const scalar checkSeconds = checkTimer.elapsedTime();
     if (nInverted > 0)
     {
         if (invertedCellsFatal_)
@@ -347,8 +349,8 @@ void Foam::interpolatingMotionSolver::solve()
 
     if (!summary.empty())
     {
-        Info<< type() << ": " << summary.c_str() << ", "
-            << timer.elapsedTime() << " s" << endl;
+        Info<< type() << ": " << summary.c_str() << ", inverted-cell check "
+            << checkSeconds << " s, " << timer.elapsedTime() << " s" << endl;
     }
 }
 
