@@ -68,7 +68,7 @@ struct multilevel<D>::level
     std::vector<std::uint8_t> readEveryFit; ///< per own point in ctrlOrder_
     std::vector<double> rr;                 ///< per own point x component: r/sum(w^2) of the last fit
     bool complete = true;                   ///< every point's phi stored since the last fit
-    std::vector<double> phi, invOmega; ///< view data: coefficients, 1/omega (0 where omega is)
+    hugeVector<double> phi, invOmega; ///< view data: coefficients, 1/omega (0 where omega is)
     std::vector<std::vector<std::int64_t>> sendTiles, recvTiles; ///< view tile ids per rank (own ones / received ones)
     /// Own tiles (view ids) that a lower rank also contributes to: this
     /// rank's partial sums there are set aside and added in rank order
@@ -361,7 +361,7 @@ void multilevel<D>::buildLevel(int k)
     });
     const std::int64_t nOwn = L.own.size();
     std::vector<stencilTiles<D>> ownIds(ctrlOrder_.size());
-    std::vector<double> ownW(nOwn*npt*nw_, 0.0);
+    hugeVector<double> ownW(nOwn*npt*nw_, 0.0);     // (may become the view's omega)
     std::size_t pos = 0;
     forOwnStencils(L, [&](std::size_t i, const stencil<D>& st) {
         findTiles(L.own, st, ownIds[pos]);
@@ -902,7 +902,7 @@ inline int parents(std::int64_t jf, std::int64_t lo, std::int64_t hi, std::int64
 /// level on the node box fb, one direction at a time (the parents of fb's
 /// nodes that the stencils of points inside the boxes use lie in cb)
 template <int D>
-void refine(std::vector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, std::vector<double>& T)
+void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, hugeVector<double>& T)
 {
     index<D> n;
     for (int d = 0; d < D; ++d) n[d] = cb.hi[d] - cb.lo[d] + 1;
@@ -1079,8 +1079,8 @@ void multilevel<D>::fold()
     while (m + 1 < report_.levels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
     if (m < 0) return;
     // flatPhi_ and foldScratch_ keep their storage from fit to fit
-    std::vector<double>& G = flatPhi_;
-    std::vector<double>& T = foldScratch_;
+    hugeVector<double>& G = flatPhi_;
+    hugeVector<double>& T = foldScratch_;
     indexBox<D> gb;
     for (int k = 0; k <= m; ++k)
     {
@@ -1216,6 +1216,13 @@ void multilevel<D>::evaluate(std::vector<double>& out) const
     // which the points' own order then gathers them (the reads and writes of
     // points and results stay in sequence)
     const bool own = evalOrder_.empty();
+    if (out.capacity() < eval_.size*nc_)
+    {
+        // (a new array: on huge pages where the kernel takes the advice)
+        std::vector<double>().swap(out);
+        out.reserve(eval_.size*nc_);
+        adviseHugePages(out.data(), eval_.size*nc_*sizeof(double));
+    }
     out.resize(eval_.size*nc_);     // (every value is written below)
     if (!own) sweep_.resize(eval_.size*nc_);
     double* dst = own ? out.data() : sweep_.data();

@@ -29,6 +29,7 @@
 
 #include "affine.hpp"
 #include "communicator.hpp"
+#include "hugePages.hpp"
 #include "lattice.hpp"
 
 #include <memory>
@@ -112,11 +113,12 @@ class multilevel
     std::vector<std::uint32_t> ctrlOrder_; ///< active control points in space-filling-curve order
     std::vector<std::uint32_t> evalOrder_; ///< evaluation points in curve order (empty: their own order)
     std::size_t evalAt(std::size_t q) const { return evalOrder_.empty() ? q : evalOrder_[q]; }
-    std::vector<point<D>> ctrlU0_, evalU0_; ///< level-0 local coordinates of the active control / evaluation points, in ctrlOrder_ / evalOrder_
+    std::vector<point<D>> ctrlU0_;      ///< level-0 local coordinates of the active control points, in ctrlOrder_
+    hugeVector<point<D>> evalU0_;       ///< the same of the evaluation points, in evalOrder_
     std::vector<stencil<D>> stencils_;  ///< a fit's control-point stencils at the current level
     std::vector<stencil<D>> cubed_;     ///< the same with their weights cubed (for the scatter)
     std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_ (curve order only)
-    mutable std::vector<double> sweep_; ///< evaluate()'s values in curve order (kept: no new pages per call)
+    mutable hugeVector<double> sweep_;  ///< evaluate()'s values in curve order (kept: no new pages per call)
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
     std::vector<double> rr_;            ///< a fit's r/sum(w^2) per control point x component at the current level
@@ -129,7 +131,7 @@ class multilevel
     int flat_ = -1;
     point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
     indexBox<D> flatBox_;
-    std::vector<double> flatPhi_, foldScratch_;
+    hugeVector<double> flatPhi_, foldScratch_;
     /// The evaluation points (positions in evalOrder_, ascending) where levels
     /// above flat_ have coefficients at the point's stencil (a node with
     /// omega > 0; phi is 0 at the others), and those levels: bit j for level

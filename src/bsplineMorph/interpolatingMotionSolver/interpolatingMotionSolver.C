@@ -19,6 +19,7 @@ License
 #include "clockTime.H"
 #include "Enum.H"
 #include "mapPolyMesh.H"
+#include "hugePages.hpp"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
@@ -67,7 +68,11 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
     const labelList& nei = mesh().faceNeighbour();
     const point x0 = mesh().bounds().centre();
     scalarField& vol = cellVol_;
-    vol.setSize(mesh().nCells());
+    if (vol.size() != mesh().nCells())
+    {
+        vol.setSize(mesh().nCells());
+        mba::adviseHugePages(vol.data(), vol.size()*sizeof(scalar));
+    }
     vol = 0;
     forAll(faces, facei)
     {
@@ -268,7 +273,13 @@ void Foam::interpolatingMotionSolver::solve()
     // directions a 2D mesh does not solve for
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     const pointField& p0 = points0();
-    newPoints_.setSize(p0.size());
+    if (newPoints_.size() != p0.size())
+    {
+        // (the moved points are swept by every step and the check: on huge
+        // pages where the kernel has them, as the core's arrays)
+        newPoints_.setSize(p0.size());
+        mba::adviseHugePages(newPoints_.data(), newPoints_.size()*sizeof(point));
+    }
     slot_ = 0;
     if (constraintsPtr_->nControlGlobal() == 0)
     {

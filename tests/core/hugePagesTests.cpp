@@ -1,0 +1,86 @@
+#include <catch2/catch.hpp>
+#include "hugePages.hpp"
+
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+using namespace mba;
+
+namespace {
+
+/// The kernel's transparent-huge-page mode: "always", "madvise", "never", or
+/// "" where the kernel has none
+std::string thpMode()
+{
+    std::ifstream f("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::string line;
+    std::getline(f, line);
+    const auto a = line.find('['), b = line.find(']');
+    return a == std::string::npos || b == std::string::npos ? "" : line.substr(a + 1, b - a - 1);
+}
+
+/// kB of huge pages backing the mapping that holds address p (/proc/self/smaps)
+long hugeKBAt(const void* p)
+{
+    const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(p);
+    std::ifstream f("/proc/self/smaps");
+    std::string line;
+    bool inside = false;
+    while (std::getline(f, line))
+    {
+        if (line.find("AnonHugePages:") == 0)
+        {
+            if (inside) return std::stol(line.substr(14));
+            continue;
+        }
+        // a mapping's first line: "lo-hi perms offset dev inode [name]"
+        std::uintptr_t lo, hi;
+        char dash;
+        std::istringstream s(line);
+        if (line.find(':') > line.find(' ') && s >> std::hex >> lo >> dash >> hi && dash == '-') inside = lo <= a && a < hi;
+    }
+    return -1;
+}
+
+} // namespace
+
+TEST_CASE("Vectors on huge pages keep their values through every growth", "[core][memory]")
+{
+    // small (operator new) to large (a mapping of its own) and larger, copies
+    hugeVector<double> v{1.5, 2.5, 3.5};
+    for (const std::size_t n : {std::size_t(100), std::size_t(1) << 19, std::size_t(3) << 20})
+    {
+        v.resize(n, -1.0);
+        REQUIRE(v.size() == n);
+        CHECK(v[0] == 1.5);
+        CHECK(v[2] == 3.5);
+        CHECK(v[3] == -1.0);
+        CHECK(v[n - 1] == -1.0);
+    }
+    const hugeVector<double> w(v);
+    CHECK((w == v));      // (not decomposed: Catch would print 3M values)
+    v.assign(7, 4.0);
+    CHECK(v == hugeVector<double>(7, 4.0));
+}
+
+TEST_CASE("Large vectors get huge pages where the kernel offers them", "[core][memory]")
+{
+    // A range without a whole aligned huge page is left alone
+    std::vector<double> small(1000);
+    CHECK_FALSE(adviseHugePages(small.data(), small.size()*sizeof(double)));
+
+    const std::string mode = thpMode();
+    if (mode != "always" && mode != "madvise")
+    {
+        WARN("transparent huge pages are '" << mode << "' here: only the values are checked");
+        return;
+    }
+    // 16 MiB, written: its own mapping, whose aligned interior is huge pages
+    hugeVector<double> v(std::size_t(1) << 21, 1.0);
+    const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(v.data());
+    const std::uintptr_t page = (a + hugePageBytes - 1) & ~std::uintptr_t(hugePageBytes - 1);
+    INFO("THP mode " << mode);
+    CHECK(hugeKBAt(reinterpret_cast<const void*>(page)) >= 2048*7);
+}
