@@ -43,6 +43,20 @@ namespace Foam
                 "invertedCells", dict, onInverted::fatal
             ) == onInverted::fatal;
         }
+
+        //- Size a mesh-sized work array swept every step; when it is
+        //  allocated, ask for huge pages before it is first written (as the
+        //  core's arrays; best effort: malloc may hand out memory written
+        //  before, which keeps its pages)
+        template<class T>
+        void setSizeOnHugePages(List<T>& list, const label n)
+        {
+            if (list.size() != n)
+            {
+                list.setSize(n);
+                mba::adviseHugePages(list.data(), n*sizeof(T));
+            }
+        }
     }
 }
 
@@ -68,11 +82,7 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
     const labelList& nei = mesh().faceNeighbour();
     const point x0 = mesh().bounds().centre();
     scalarField& vol = cellVol_;
-    if (vol.size() != mesh().nCells())
-    {
-        vol.setSize(mesh().nCells());
-        mba::adviseHugePages(vol.data(), vol.size()*sizeof(scalar));
-    }
+    setSizeOnHugePages(vol, mesh().nCells());
     vol = 0;
     forAll(faces, facei)
     {
@@ -273,13 +283,7 @@ void Foam::interpolatingMotionSolver::solve()
     // directions a 2D mesh does not solve for
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     const pointField& p0 = points0();
-    if (newPoints_.size() != p0.size())
-    {
-        // (the moved points are swept by every step and the check: on huge
-        // pages where the kernel has them, as the core's arrays)
-        newPoints_.setSize(p0.size());
-        mba::adviseHugePages(newPoints_.data(), newPoints_.size()*sizeof(point));
-    }
+    setSizeOnHugePages(newPoints_, p0.size());
     slot_ = 0;
     if (constraintsPtr_->nControlGlobal() == 0)
     {
