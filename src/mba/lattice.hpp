@@ -481,6 +481,29 @@ void sweepStencil(const double* phi, const stencilTiles<D>& tid, const stencil<D
     withOffset(st, [&](auto oz) { sweepStencil<D, NC, decltype(oz)::value>(phi, tid, st, out); });
 }
 
+/// The values at a stencil's nodes (absent tiles read as zero) as a plain
+/// block of 4^D nodes, the last direction fastest, NC values a node: row i
+/// of the stencil (in forRows' order) at block[i*4*NC]
+template <int D, int NC, int OZ>
+inline __attribute__((always_inline)) void gatherStencil(const double* phi, const stencilTiles<D>& tid,
+                                                         const stencil<D>& st, double* block)
+{
+    constexpr int R = 4*NC;
+    static constexpr double zero[R] = {};
+    auto row = [phi, &tid](int t, int n) { return tileRow<D, NC>(phi, tid[t], n, zero); };
+    int i = 0;
+    forRows(st, [&](int t, int n, double) {
+        loadSplit<NC, OZ>(row(t, n), OZ ? row(t + 1, n) : zero).store(block + R*i++);
+    });
+}
+
+template <int D, int NC>
+inline __attribute__((always_inline)) void gatherStencil(const double* phi, const stencilTiles<D>& tid,
+                                                         const stencil<D>& st, double* block)
+{
+    withOffset(st, [&](auto oz) { gatherStencil<D, NC, decltype(oz)::value>(phi, tid, st, block); });
+}
+
 /// Adds w_n r (NC values) to each node n of the stencil, w_n the product of
 /// the stencil's weights (given cubed, for the fit's delta), row by row as the
 /// sweep reads them (or stores it: put). Nodes in absent tiles (id < 0) are

@@ -120,6 +120,10 @@ void scaleNodes(double* v, const double* s, std::size_t nNodes)
 /// Runs shorter than this (single points) are scattered point after point
 constexpr std::size_t minRun = 2;
 
+/// Runs at least this long are evaluated through a copy of their stencil's
+/// nodes (evalRun): copying them costs about what one point's sweep does
+constexpr std::size_t minBlockRun = 4;
+
 /// scatter for a run of n points whose stencils share their nodes (cubed:
 /// their stencils cubed, rr: nc values a point); the sums are formed in
 /// another order than point after point
@@ -159,6 +163,93 @@ void scatterSeparated(double* phi, int nc, const stencilTiles<D>& tid, const ste
         case 1: detail::scatterStencil<D, 1, put::select>(phi, tid, st, rr, on); break;
         case 2: detail::scatterStencil<D, 2, put::select>(phi, tid, st, rr, on); break;
         default: detail::scatterStencil<D, 3, put::select>(phi, tid, st, rr, on);
+    }
+}
+
+/// Node i of a plain lattice over the nodes of box b (the last direction
+/// fastest, nc values a node)
+template <int D>
+inline const double* flatNode(const double* G, const indexBox<D>& b, const index<D>& i, int nc)
+{
+    return G + boxIndex<D>(b, i)*nc;
+}
+
+/// Adds the value at a stencil of a plain lattice (nodes of box b, the last
+/// direction fastest, NC values per node): the 4 nodes along the last
+/// direction are contiguous, so the 4^(D-1) rows are summed first, as
+/// vectors of W doubles, into two accumulators (alternate rows: two
+/// independent add chains)
+template <int NC, int W>
+inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<3>& b,
+                                                       const stencil<3>& st, double* out)
+{
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
+    const double* p0 = flatNode<3>(G, b, st.base, NC);
+    detail::vrow<4*NC, W> r[2] = {};
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
+    detail::add(r[0], r[1]);
+    detail::addRowSum<NC, W>(r[0], st.w[2], out);
+}
+
+template <int NC, int W>
+inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<2>& b,
+                                                       const stencil<2>& st, double* out)
+{
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
+    const double* p0 = flatNode<2>(G, b, st.base, NC);
+    detail::vrow<4*NC, W> r[2] = {};
+    for (int a = 0; a < 4; ++a) detail::axpy<4*NC, W>(r[a & 1], st.w[0][a], p0 + a*n1*NC);
+    detail::add(r[0], r[1]);
+    detail::addRowSum<NC, W>(r[0], st.w[1], out);
+}
+
+/// The lattice's values at a run of n points whose stencils share their
+/// nodes (st: their stencils), added to out (NC a point): the stencil's nodes
+/// are copied once into a plain 4^D block, which each point then reads as a
+/// flat lattice (whole rows, no tiles), in vectors of W doubles
+template <int D, int NC, int W>
+inline __attribute__((always_inline)) void evalRunAs(const double* phi, const stencilTiles<D>& tid,
+                                                     const stencil<D>* st, std::size_t n, double* out)
+{
+    double block[(D == 3 ? 64 : 16)*NC];
+    detail::gatherStencil<D, NC>(phi, tid, st[0], block);
+    indexBox<D> b;
+    for (int d = 0; d < D; ++d) { b.lo[d] = st[0].base[d]; b.hi[d] = b.lo[d] + 3; }
+    for (std::size_t j = 0; j < n; ++j) flatStencil<NC, W>(block, b, st[j], out + j*NC);
+}
+
+#ifdef MBA_WIDE_VECTORS
+/// The same compiled for AVX2 with FMA, in vectors of four doubles
+template <int D, int NC>
+MBA_WIDE_TARGET void evalRunWide(const double* phi, const stencilTiles<D>& tid, const stencil<D>* st,
+                                 std::size_t n, double* out)
+{
+    evalRunAs<D, NC, 4>(phi, tid, st, n, out);
+}
+#endif
+
+template <int D>
+void evalRun(const double* phi, int nc, const stencilTiles<D>& tid, const stencil<D>* st, std::size_t n,
+             double* out)
+{
+#ifdef MBA_WIDE_VECTORS
+    if (wideVectors())
+    {
+        switch (nc)
+        {
+            case 1: evalRunWide<D, 1>(phi, tid, st, n, out); break;
+            case 2: evalRunWide<D, 2>(phi, tid, st, n, out); break;
+            default: evalRunWide<D, 3>(phi, tid, st, n, out);
+        }
+        return;
+    }
+#endif
+    switch (nc)
+    {
+        case 1: evalRunAs<D, 1, 2>(phi, tid, st, n, out); break;
+        case 2: evalRunAs<D, 2, 2>(phi, tid, st, n, out); break;
+        default: evalRunAs<D, 3, 2>(phi, tid, st, n, out);
     }
 }
 
@@ -788,12 +879,20 @@ void multilevel<D>::applyLevel(level& L)
         }
         return;
     }
-    for (std::size_t q = 0; q < ctrlOrder_.size(); ++q)
+    // (the level's values first, in a pass of their own: subtracting each
+    // right after its sum was stored in pieces would stall on the loads)
+    atCtrl_.assign(nq*nc_, 0.0);
+    for (std::size_t q = 0, e; q < nq; q = e)
+    {
+        for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
+        if (e - q >= minBlockRun) evalRun<D>(L.phi.data(), nc_, L.ctrlView[q], &stencils_[q], e - q, &atCtrl_[q*nc_]);
+        else
+            for (std::size_t j = q; j < e; ++j) evalStencil(L.phi.data(), nc_, L.ctrlView[j], stencils_[j], &atCtrl_[j*nc_]);
+    }
+    for (std::size_t q = 0; q < nq; ++q)
     {
         const std::size_t i = ctrlOrder_[q];
-        double acc[3] = {0, 0, 0};
-        evalStencil(L.phi.data(), nc_, L.ctrlView[q], stencils_[q], acc);
-        for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= acc[c];
+        for (int c = 0; c < nc_; ++c) residual_[i*nc_ + c] -= atCtrl_[q*nc_ + c];
     }
 }
 
@@ -937,44 +1036,6 @@ void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb,
         n[d] = nf;
         G.swap(T);
     }
-}
-
-/// Node i of a plain lattice over the nodes of box b (the last direction
-/// fastest, nc values a node)
-template <int D>
-inline const double* flatNode(const double* G, const indexBox<D>& b, const index<D>& i, int nc)
-{
-    return G + boxIndex<D>(b, i)*nc;
-}
-
-/// Adds the value at a stencil of a plain lattice (nodes of box b, the last
-/// direction fastest, NC values per node): the 4 nodes along the last
-/// direction are contiguous, so the 4^(D-1) rows are summed first, as
-/// vectors of W doubles, into two accumulators (alternate rows: two
-/// independent add chains)
-template <int NC, int W>
-inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<3>& b,
-                                                       const stencil<3>& st, double* out)
-{
-    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
-    const double* p0 = flatNode<3>(G, b, st.base, NC);
-    detail::vrow<4*NC, W> r[2] = {};
-    for (int a = 0; a < 4; ++a)
-        for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
-    detail::add(r[0], r[1]);
-    detail::addRowSum<NC, W>(r[0], st.w[2], out);
-}
-
-template <int NC, int W>
-inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<2>& b,
-                                                       const stencil<2>& st, double* out)
-{
-    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1;
-    const double* p0 = flatNode<2>(G, b, st.base, NC);
-    detail::vrow<4*NC, W> r[2] = {};
-    for (int a = 0; a < 4; ++a) detail::axpy<4*NC, W>(r[a & 1], st.w[0][a], p0 + a*n1*NC);
-    detail::add(r[0], r[1]);
-    detail::addRowSum<NC, W>(r[0], st.w[1], out);
 }
 
 /// Asks the cache for the rows of the flat lattice's stencil at u (level-local

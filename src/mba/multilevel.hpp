@@ -122,6 +122,7 @@ class multilevel
     std::vector<std::unique_ptr<level>> levels_;
     std::vector<double> residual_, scratch_;
     std::vector<double> rr_;            ///< a fit's r/sum(w^2) per control point x component at the current level
+    std::vector<double> atCtrl_;        ///< the current level's values at the control points (in ctrlOrder_)
     /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed, with
     /// the affine approximation (reproduced exactly by its node values), into
     /// one plain, untiled lattice over the level-flat_ nodes that the planned

@@ -12,6 +12,8 @@
 #include "multilevelBSplineMotionSolver.H"
 #include "IStringStream.H"
 #include "IOdictionary.H"
+#include "fvMesh.H"
+#include "volFields.H"
 
 #include <limits>
 
@@ -89,6 +91,36 @@ TEST_CASE("multilevelBSpline: the defaults give a working solver", "[foam][bspli
     REQUIRE(solver.valid());
     CHECK(solver->type() == "multilevelBSpline");
     requireUnmoved(solver.ref(), 0);
+}
+
+
+TEST_CASE("The inverted-cell check's volumes: exact for planar faces, negative in mirrored cells", "[foam][bsplineMorph]")
+{
+    // The box folded about its mid-plane x = 1/2 (a plane of mesh points),
+    // then sheared and stretched: every face stays planar, the cells below
+    // the plane are mirrored (volume -det(A) V), the others not (det(A) V)
+    const fvMesh& mesh = bsmTest::mesh();
+    const pointField& p0 = mesh.points();
+    const tensor A(1.2, 0.3, 0, 0, 0.9, 0.2, 0.1, 0, 1.1);
+    pointField p(p0.size());
+    forAll(p0, pointi)
+    {
+        vector x = p0[pointi];
+        x.x() = mag(x.x() - 0.5);
+        p[pointi] = (A & x) + vector(0.3, -0.2, 0.1);
+    }
+    scalarField vol;
+    interpolatingMotionSolver::signedCellVolumes(mesh, p, vol);
+    REQUIRE(vol.size() == mesh.nCells());
+    label nMirrored = 0;
+    forAll(vol, celli)
+    {
+        const scalar sign = mesh.C()[celli].x() < 0.5 ? -1 : 1;
+        nMirrored += (sign < 0);
+        REQUIRE(vol[celli] == Approx(sign*det(A)*mesh.V()[celli]).epsilon(1e-12));
+    }
+    const label nCells = bsmTest::caseCells[0]*bsmTest::caseCells[1]*bsmTest::caseCells[2];
+    CHECK(returnReduce(nMirrored, sumOp<label>()) == nCells/2);
 }
 
 

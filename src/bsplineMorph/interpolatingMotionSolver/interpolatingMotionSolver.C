@@ -68,62 +68,11 @@ Foam::label Foam::interpolatingMotionSolver::nInvertedCells
     const pointField& points
 ) const
 {
-    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
-    // never sees an inverted cell): the divergence theorem over the faces,
-    // 3V = sum over a cell's faces of area vector . (face point - x0) for
-    // any x0 (a closed cell's area vectors add up to 0), each face as its
-    // area vector (twice it: for a quad the cross product of its diagonals,
-    // else the triangles about its first vertex) and its vertex mean, x0 the
-    // centre of the mesh's bounds (for every cell: one term per face, added
-    // to its owner and taken from its neighbour). Exact for planar faces;
-    // one pass over the faces, no square roots, no face arrays.
-    const faceList& faces = mesh().faces();
-    const labelList& own = mesh().faceOwner();
-    const labelList& nei = mesh().faceNeighbour();
-    const point x0 = mesh().bounds().centre();
-    scalarField& vol = cellVol_;
-    setSizeOnHugePages(vol, mesh().nCells());
-    vol = 0;
-    forAll(faces, facei)
-    {
-        // (a face's labels lie elsewhere: asked for some faces ahead)
-        if (facei + 32 < faces.size()) __builtin_prefetch(faces[facei + 32].cdata());
-        const face& f = faces[facei];
-        const point& p0 = points[f[0]];
-        vector sum, area;
-        if (f.size() == 4)
-        {
-            const point& p1 = points[f[1]];
-            const point& p2 = points[f[2]];
-            const point& p3 = points[f[3]];
-            sum = p0 + p1 + p2 + p3;
-            area = (p2 - p0) ^ (p3 - p1);
-        }
-        else
-        {
-            sum = p0;
-            area = Zero;
-            for (label i = 1; i < f.size(); ++i)
-            {
-                const point& p = points[f[i]];
-                sum += p;
-                if (i + 1 < f.size())
-                {
-                    area += (p - p0) ^ (points[f[i + 1]] - p0);
-                }
-            }
-        }
-        const scalar v = area & (sum/f.size() - x0);
-        vol[own[facei]] += v;
-        if (facei < nei.size())
-        {
-            vol[nei[facei]] -= v;
-        }
-    }
+    signedCellVolumes(mesh(), points, cellVol_);
     label n = 0;
-    forAll(vol, celli)
+    for (const scalar v : cellVol_)
     {
-        if (!(vol[celli] > 0))
+        if (!(v > 0))
         {
             ++n;
         }
@@ -166,17 +115,27 @@ std::string Foam::interpolatingMotionSolver::interpolateInto
     const std::string summary = interpolate(values_);
     // The interpolated points' displacement (zero outside the solution
     // directions) and their moved points, in one pass
+    // (each component read from its packed value or zero, into registers:
+    // a vector filled through d[dirs[k]] stalls every point on its stores)
     const labelList& dirs = constraintsPtr_->directions();
     const label nd = dirs.size();
+    label at[3] = {-1, -1, -1};         // packed position of each direction
+    forAll(dirs, k)
+    {
+        at[dirs[k]] = k;
+    }
     const pointField& p0 = points0();
+    const double* v = values_.data();
     forAll(evalPoints_, i)
     {
         const label pointi = evalPoints_[i];
-        vector d(Zero);
-        for (label k = 0; k < nd; ++k)
-        {
-            d[dirs[k]] = values_[i*nd + k];
-        }
+        const vector d
+        (
+            at[0] < 0 ? 0 : v[at[0]],
+            at[1] < 0 ? 0 : v[at[1]],
+            at[2] < 0 ? 0 : v[at[2]]
+        );
+        v += nd;
         displacement[pointi] = d;
         newPoints_[pointi] = p0[pointi] + d;
     }
@@ -366,6 +325,84 @@ void Foam::interpolatingMotionSolver::solve()
     {
         Info<< type() << ": " << summary.c_str() << ", inverted-cell check "
             << checkSeconds << " s, " << timer.elapsedTime() << " s" << endl;
+    }
+}
+
+
+void Foam::interpolatingMotionSolver::signedCellVolumes
+(
+    const polyMesh& mesh,
+    const pointField& points,
+    scalarField& vol
+)
+{
+    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
+    // never sees an inverted cell): the divergence theorem over the faces,
+    // V = sum over a cell's faces of area vector . (face point - x0)/3 for
+    // any x0 (a closed cell's area vectors add up to 0), each face as its
+    // area vector (twice it: for a quad the cross product of its diagonals,
+    // else the triangles about its first vertex) and its vertex mean, x0 the
+    // centre of the mesh's bounds (for every cell: one term per face, added
+    // to its owner and taken from its neighbour). Exact for planar faces;
+    // one pass over the faces, no square roots, no face arrays.
+    const faceList& faces = mesh.faces();
+    const labelList& own = mesh.faceOwner();
+    const labelList& nei = mesh.faceNeighbour();
+    const point x0 = mesh.bounds().centre();
+    const scalar sixth = 1.0/6;   // (a third, of twice the area)
+    setSizeOnHugePages(vol, mesh.nCells());
+    vol = 0;
+    // (faces come in owner order: a face's term goes to its owner through a
+    // register while the owner stays the same; added to memory face after
+    // face, each would wait for the previous one's store)
+    label owner = own.empty() ? -1 : own[0];
+    scalar ownerSum = 0;
+    forAll(faces, facei)
+    {
+        // (a face's labels lie elsewhere: asked for some faces ahead)
+        if (facei + 32 < faces.size()) __builtin_prefetch(faces[facei + 32].cdata());
+        const face& f = faces[facei];
+        const point& p0 = points[f[0]];
+        vector mean, area;
+        if (f.size() == 4)
+        {
+            const point& p1 = points[f[1]];
+            const point& p2 = points[f[2]];
+            const point& p3 = points[f[3]];
+            mean = 0.25*(p0 + p1 + p2 + p3);
+            area = (p2 - p0) ^ (p3 - p1);
+        }
+        else
+        {
+            vector sum = p0;
+            area = Zero;
+            for (label i = 1; i < f.size(); ++i)
+            {
+                const point& p = points[f[i]];
+                sum += p;
+                if (i + 1 < f.size())
+                {
+                    area += (p - p0) ^ (points[f[i + 1]] - p0);
+                }
+            }
+            mean = sum/f.size();
+        }
+        const scalar v = (area & (mean - x0))*sixth;
+        if (own[facei] != owner)
+        {
+            vol[owner] += ownerSum;
+            owner = own[facei];
+            ownerSum = 0;
+        }
+        ownerSum += v;
+        if (facei < nei.size())
+        {
+            vol[nei[facei]] -= v;
+        }
+    }
+    if (owner >= 0)
+    {
+        vol[owner] += ownerSum;
     }
 }
 
