@@ -120,16 +120,23 @@ template <int D> struct stencil
 
     /// From level-local coordinates u >= 0 (as domain::local0 makes them):
     /// cell floor(u), s = u - floor(u); floor as truncation, which is one
-    /// instruction on every x86-64 (std::floor is a call without SSE4.1).
-    /// cubed: the weights cubed (the fit's scatter)
-    explicit stencil(const double* u, bool cubed = false)
+    /// instruction on every x86-64 (std::floor is a call without SSE4.1)
+    explicit stencil(const double* u)
     {
         for (int d = 0; d < D; ++d)
         {
             base[d] = std::int64_t(u[d]);
             cubicBasis(u[d] - double(base[d]), w[d]);
-            if (cubed) for (double& x : w[d]) x = x*x*x;
         }
+    }
+
+    /// The same stencil with its weights cubed (the fit's scatter)
+    stencil cubedWeights() const
+    {
+        stencil s = *this;
+        for (int d = 0; d < D; ++d)
+            for (double& x : s.w[d]) x = x*x*x;
+        return s;
     }
 
     double sumSquares() const
@@ -549,56 +556,53 @@ MBA_WIDE_TARGET void scatterStencilWide(double* delta, const stencilTiles<D>& ti
 
 /// scatterStencilWide for a run of n points whose stencils share their nodes
 /// (the same first node: coarse levels, where many points lie in one cell):
-/// per chunk of points, each tile row's sum over the chunk is formed in
-/// registers and added to the lattice once (st: the points' stencils, r:
-/// their values, NC a point)
+/// the run is summed into a plain 4^D block of the stencil's nodes (whole
+/// rows of 4 nodes whatever the offset in the tiles), per chunk of points
+/// each row's sum over the chunk formed in registers, and the block is added
+/// to the lattice once (st: the points' stencils, r: their values, NC a point)
 template <int D, int NC, int OZ>
 MBA_WIDE_TARGET void scatterRunWide(double* delta, const stencilTiles<D>& tid, const stencil<D>* st,
                                     const double* r, std::size_t n)
 {
-    constexpr int R = 4*NC, H = OZ ? 2 : 1;
+    constexpr int R = 4*NC;
     constexpr int nRows = D == 3 ? 16 : 4;
     constexpr std::size_t chunk = 16;
-    double sink[R];
-    int rowT[nRows], rowN[nRows];
-    {
-        int j = 0;
-        forRows(st[0], [&](int t, int nn, double) { rowT[j] = t; rowN[j] = nn; ++j; });
-    }
-    vrow<R, 4> u[chunk][H];        // per point: its values times the last direction's weights, by tile row
-    double w[chunk][nRows];        // per point: its rows' weights in the other directions
+    vrow<R, 4> block[nRows] = {};
+    vrow<R, 4> u[chunk];            // per point: its values times the last direction's weights
+    double w[chunk][nRows];         // per point: its rows' weights in the other directions
     for (std::size_t p0 = 0; p0 < n; p0 += chunk)
     {
         const std::size_t m = std::min(chunk, n - p0);
         for (std::size_t j = 0; j < m; ++j)
         {
             const stencil<D>& sj = st[p0 + j];
-            double uj[2*R] = {};
-            lastDirection<NC>(sj.w[D - 1], r + (p0 + j)*NC, OZ, uj);
-            for (int h = 0; h < H; ++h) u[j][h] = vrow<R, 4>::load(uj + h*R);
+            double uj[R];
+            lastDirection<NC>(sj.w[D - 1], r + (p0 + j)*NC, 0, uj);
+            u[j] = vrow<R, 4>::load(uj);
             int i = 0;
             forRows(sj, [&](int, int, double wr) { w[j][i++] = wr; });
         }
         // two rows at a time: independent add chains
         for (int i = 0; i < nRows; i += 2)
         {
-            vrow<R, 4> acc[2][H] = {};
+            vrow<R, 4> acc[2] = {};
             for (std::size_t j = 0; j < m; ++j)
-                for (int h = 0; h < H; ++h)
-                {
-                    axpy<R, 4>(acc[0][h], w[j][i], u[j][h]);
-                    axpy<R, 4>(acc[1][h], w[j][i + 1], u[j][h]);
-                }
-            for (int e = 0; e < 2; ++e)
-                for (int h = 0; h < H; ++h)
-                {
-                    double* p = tileRow<D, NC>(delta, tid[rowT[i + e] + h], rowN[i + e], sink);
-                    vrow<R, 4> x = vrow<R, 4>::load(p);
-                    add(x, acc[e][h]);
-                    x.store(p);
-                }
+            {
+                axpy<R, 4>(acc[0], w[j][i], u[j]);
+                axpy<R, 4>(acc[1], w[j][i + 1], u[j]);
+            }
+            add(block[i], acc[0]);
+            add(block[i + 1], acc[1]);
         }
     }
+    double sink[R] = {};
+    int i = 0;
+    forRows(st[0], [&](int t, int nn, double) {
+        double b[R];
+        block[i++].store(b);
+        addSplit<NC, OZ>(tileRow<D, NC>(delta, tid[t], nn, sink), OZ ? tileRow<D, NC>(delta, tid[t + 1], nn, sink) : sink,
+                         1.0, vrow<R>::load(b));
+    });
 }
 #endif
 

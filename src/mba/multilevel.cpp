@@ -174,22 +174,32 @@ inline const double* flatNode(const double* G, const indexBox<D>& b, const index
     return G + boxIndex<D>(b, i)*nc;
 }
 
+/// Adds to out[0..NC) the value at a stencil of a plain 3D lattice whose
+/// first node is p0 (n1, n2: the box's nodes along the second and last
+/// directions; the last direction fastest, NC values a node): the 4 nodes
+/// along the last direction are contiguous, so the 16 rows, weighted by
+/// rowW(a, c) (the product of the first two directions' weights), are summed
+/// first, as vectors of W doubles, into two accumulators (alternate rows:
+/// two independent add chains), and the sum then weighted by wLast
+template <int NC, int W, class RowW>
+inline __attribute__((always_inline)) void flatRows(const double* p0, std::int64_t n1, std::int64_t n2,
+                                                    RowW&& rowW, const double* wLast, double* out)
+{
+    detail::vrow<4*NC, W> r[2] = {};
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], rowW(a, c), p0 + (a*n1 + c)*n2*NC);
+    detail::add(r[0], r[1]);
+    detail::addRowSum<NC, W>(r[0], wLast, out);
+}
+
 /// Adds the value at a stencil of a plain lattice (nodes of box b, the last
-/// direction fastest, NC values per node): the 4 nodes along the last
-/// direction are contiguous, so the 4^(D-1) rows are summed first, as
-/// vectors of W doubles, into two accumulators (alternate rows: two
-/// independent add chains)
+/// direction fastest, NC values per node), as flatRows
 template <int NC, int W>
 inline __attribute__((always_inline)) void flatStencil(const double* G, const indexBox<3>& b,
                                                        const stencil<3>& st, double* out)
 {
-    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
-    const double* p0 = flatNode<3>(G, b, st.base, NC);
-    detail::vrow<4*NC, W> r[2] = {};
-    for (int a = 0; a < 4; ++a)
-        for (int c = 0; c < 4; ++c) detail::axpy<4*NC, W>(r[c & 1], st.w[0][a]*st.w[1][c], p0 + (a*n1 + c)*n2*NC);
-    detail::add(r[0], r[1]);
-    detail::addRowSum<NC, W>(r[0], st.w[2], out);
+    flatRows<NC, W>(flatNode<3>(G, b, st.base, NC), b.hi[1] - b.lo[1] + 1, b.hi[2] - b.lo[2] + 1,
+                    [&](int a, int c) { return st.w[0][a]*st.w[1][c]; }, st.w[2], out);
 }
 
 template <int NC, int W>
@@ -418,10 +428,9 @@ template <int D>
 multilevel<D>::~multilevel() = default;
 
 template <int D>
-inline __attribute__((always_inline)) stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q,
-                                                                          bool cubed) const
+inline __attribute__((always_inline)) stencil<D> multilevel<D>::ctrlStencil(const level& L, std::size_t q) const
 {
-    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data(), cubed);
+    return stencil<D>(scaled<D>(ctrlU0_[q], L.scale).data());
 }
 
 template <int D>
@@ -752,7 +761,7 @@ void multilevel<D>::applyLevel(level& L)
     for (std::size_t q = 0; q < nq; ++q)
     {
         stencils_[q] = ctrlStencil(L, q);
-        if (!L.separated) cubed_[q] = ctrlStencil(L, q, true);
+        if (!L.separated) cubed_[q] = stencils_[q].cubedWeights();
     }
     // r/sum(w^2) per point
     std::vector<double>& rr = L.separated ? L.rr : rr_;
@@ -827,7 +836,7 @@ void multilevel<D>::applyLevel(level& L)
                 }
                 // as the owner does
                 if (L.separated) scatterSeparated<D>(dl.data(), nc_, L.ghostTiles[r][g], st, rr, nw_ == 1 ? nullptr : on);
-                else scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], stencil<D>(u.data(), true), rr);
+                else scatter<D>(dl.data(), nc_, L.ghostTiles[r][g], st.cubedWeights(), rr);
             }
             got[r].swap(dl);
         }
@@ -1040,14 +1049,19 @@ void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb,
 
 /// Asks the cache for the rows of the flat lattice's stencil at u (level-local
 /// coordinates): the lattice is too large for the nearer caches, and rows
-/// along the first directions lie planes apart
+/// along the first directions lie planes apart. last: the stencil asked for
+/// before, whose rows are not asked for again (where the stencil moved one
+/// node along the first direction, only its new plane of rows is)
 inline __attribute__((always_inline)) void prefetchRows(const double* G, const indexBox<3>& b, int nc,
-                                                        const point<3>& u)
+                                                        const point<3>& u, index<3>& last)
 {
-    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
     const index<3> base{{std::int64_t(u[0]), std::int64_t(u[1]), std::int64_t(u[2])}};  // as stencil's
+    if (base == last) return;
+    const int a0 = base[0] == last[0] + 1 && base[1] == last[1] && base[2] == last[2] ? 3 : 0;
+    last = base;
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
     const double* p0 = flatNode<3>(G, b, base, nc);
-    for (int a = 0; a < 4; ++a)
+    for (int a = a0; a < 4; ++a)
         for (int c = 0; c < 4; ++c)
         {
             const double* p = p0 + (a*n1 + c)*n2*nc;
@@ -1056,30 +1070,40 @@ inline __attribute__((always_inline)) void prefetchRows(const double* G, const i
         }
 }
 /// (2D lattices are small enough)
-inline void prefetchRows(const double*, const indexBox<2>&, int, const point<2>&) {}
+inline void prefetchRows(const double*, const indexBox<2>&, int, const point<2>&, index<2>&) {}
 
 /// Points ahead whose stencil rows flatSweep asks the cache for (about the
 /// time a point takes against the latency of memory)
 constexpr std::size_t prefetchDistance = 4;
 
 /// The flat lattice's values at the points with level-0 local coordinates
-/// u0[0..n), to out (nc a point)
+/// u0[0..n), to out (NC a point: a fixed size, so that a point's values go
+/// from registers to out, not through a call to copy them)
+template <int D, int NC, int W>
+inline __attribute__((always_inline)) void flatSweepAs(const double* G, const indexBox<D>& b, double sf,
+                                                       const point<D>* u0, std::size_t n, double* out)
+{
+    index<D> last;
+    last.fill(-2);      // (no stencil's)
+    for (std::size_t q = 0; q < n; ++q)
+    {
+        if (q + prefetchDistance < n) prefetchRows(G, b, NC, scaled<D>(u0[q + prefetchDistance], sf), last);
+        double acc[NC] = {};
+        flatStencil<NC, W>(G, b, stencil<D>(scaled<D>(u0[q], sf).data()), acc);
+        for (int c = 0; c < NC; ++c) out[q*NC + c] = acc[c];
+    }
+}
+
+/// The same for nc values a point
 template <int D, int W>
 inline __attribute__((always_inline)) void flatSweep(const double* G, const indexBox<D>& b, int nc, double sf,
                                                      const point<D>* u0, std::size_t n, double* out)
 {
-    for (std::size_t q = 0; q < n; ++q)
+    switch (nc)
     {
-        if (q + prefetchDistance < n) prefetchRows(G, b, nc, scaled<D>(u0[q + prefetchDistance], sf));
-        double acc[3] = {0, 0, 0};
-        const stencil<D> st(scaled<D>(u0[q], sf).data());
-        switch (nc)
-        {
-            case 1: flatStencil<1, W>(G, b, st, acc); break;
-            case 2: flatStencil<2, W>(G, b, st, acc); break;
-            default: flatStencil<3, W>(G, b, st, acc);
-        }
-        for (int c = 0; c < nc; ++c) out[q*nc + c] = acc[c];
+        case 1: flatSweepAs<D, 1, W>(G, b, sf, u0, n, out); break;
+        case 2: flatSweepAs<D, 2, W>(G, b, sf, u0, n, out); break;
+        default: flatSweepAs<D, 3, W>(G, b, sf, u0, n, out);
     }
 }
 
@@ -1090,6 +1114,65 @@ MBA_WIDE_TARGET void flatSweepWide(const double* G, const indexBox<D>& b, int nc
                                    std::size_t n, double* out)
 {
     flatSweep<D, 4>(G, b, nc, sf, u0, n, out);
+}
+
+/// The same in 3D, the stencils' weights four points at a time (one point a
+/// lane; past the end the last point again, so that every point's weights
+/// come from the same arithmetic): a point's sweep is then its 48 fused adds
+/// and little else
+template <int NC>
+MBA_WIDE_TARGET void flatSweepBlocks(const double* G, const indexBox<3>& b, double sf, const point<3>* u0,
+                                     std::size_t n, double* out)
+{
+    typedef detail::vec<4>::type v4d;
+    typedef int v4i __attribute__((vector_size(16)));
+    const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
+    index<3> last;
+    last.fill(-2);      // (no stencil's)
+    alignas(32) double wxy[16][4], wz[4][4];
+    alignas(16) int base[3][4];
+    for (std::size_t q0 = 0; q0 < n; q0 += 4)
+    {
+        const std::size_t m = std::min<std::size_t>(4, n - q0);
+        v4d w[3][4];
+        for (int d = 0; d < 3; ++d)
+        {
+            v4d u;
+            for (int j = 0; j < 4; ++j) u[j] = u0[q0 + std::min<std::size_t>(j, m - 1)][d];
+            u *= sf;
+            // the cell by truncation, as stencil's
+            const v4i i = __builtin_convertvector(u, v4i);
+            *reinterpret_cast<v4i*>(base[d]) = i;
+            cubicBasis<v4d>(u - __builtin_convertvector(i, v4d), w[d]);
+        }
+        for (int a = 0; a < 4; ++a)
+        {
+            for (int c = 0; c < 4; ++c) *reinterpret_cast<v4d*>(wxy[a*4 + c]) = w[0][a]*w[1][c];
+            *reinterpret_cast<v4d*>(wz[a]) = w[2][a];
+        }
+        for (std::size_t j = 0; j < m; ++j)
+        {
+            const std::size_t q = q0 + j;
+            if (q + prefetchDistance < n) prefetchRows(G, b, NC, scaled<3>(u0[q + prefetchDistance], sf), last);
+            const double* p0 = G + (((base[0][j] - b.lo[0])*n1 + (base[1][j] - b.lo[1]))*n2 + (base[2][j] - b.lo[2]))*NC;
+            const double wl[4] = {wz[0][j], wz[1][j], wz[2][j], wz[3][j]};
+            double acc[NC] = {};
+            flatRows<NC, 4>(p0, n1, n2, [&](int a, int c) { return wxy[a*4 + c][j]; }, wl, acc);
+            for (int c = 0; c < NC; ++c) out[q*NC + c] = acc[c];
+        }
+    }
+}
+
+template <>
+void flatSweepWide<3>(const double* G, const indexBox<3>& b, int nc, double sf, const point<3>* u0,
+                      std::size_t n, double* out)
+{
+    switch (nc)
+    {
+        case 1: flatSweepBlocks<1>(G, b, sf, u0, n, out); break;
+        case 2: flatSweepBlocks<2>(G, b, sf, u0, n, out); break;
+        default: flatSweepBlocks<3>(G, b, sf, u0, n, out);
+    }
 }
 #endif
 

@@ -147,8 +147,8 @@ class multilevel
     void buildLevel(int k);
     void applyLevel(level& L);
     template <class F> void forOwnStencils(const level& L, F&& f) const;
-    /// The stencil (its weights cubed: cubed) of control point ctrlOrder_[q]
-    stencil<D> ctrlStencil(const level& L, std::size_t q, bool cubed = false) const;
+    /// The stencil of control point ctrlOrder_[q] at level L
+    stencil<D> ctrlStencil(const level& L, std::size_t q) const;
     void residualStats(double& maxr, double& rms) const;
     void addLevels(const double* x, double* out, int nLevels) const;
     void fold();
