@@ -1154,7 +1154,7 @@ MBA_WIDE_TARGET void flatSweepBlocks(const double* G, const indexBox<3>& b, doub
         {
             const std::size_t q = q0 + j;
             if (q + prefetchDistance < n) prefetchRows(G, b, NC, scaled<3>(u0[q + prefetchDistance], sf), last);
-            const double* p0 = G + (((base[0][j] - b.lo[0])*n1 + (base[1][j] - b.lo[1]))*n2 + (base[2][j] - b.lo[2]))*NC;
+            const double* p0 = flatNode<3>(G, b, index<3>{{base[0][j], base[1][j], base[2][j]}}, NC);
             const double wl[4] = {wz[0][j], wz[1][j], wz[2][j], wz[3][j]};
             double acc[NC] = {};
             flatRows<NC, 4>(p0, n1, n2, [&](int a, int c) { return wxy[a*4 + c][j]; }, wl, acc);
