@@ -5,6 +5,9 @@
     checkPoints.py equal A B TIME [--tol T]  the points of two cases agree within T x domain size
     checkPoints.py at CASE TIME X0 Y0 Z0 X1 Y1 Z1 [--tol T]
                                              the point initially at X0 Y0 Z0 is at X1 Y1 Z1
+    checkPoints.py rigid CASE TIME INNER [--2d] [--tol T]
+                                             the points within INNER of the hole's points moved
+                                             with the hole's rigid motion (fitted to the hole)
 
 Exit status 1 on any failed check; prints what it measured. Other test scripts
 import it for readPoints, readLabels, pointsAt and check (run from the project's
@@ -52,6 +55,33 @@ def main():
         check(max(abs(p0[i][d] - x0[d]) for d in range(3)) < 1e-9, "a point at %s" % x0)
         err = max(abs(p1[i][d] - x1[d]) for d in range(3))
         check(err <= tol, "it moved to (%.12g %.12g %.12g), expected %s: error %.2e" % (p1[i] + (x1, err)))
+    elif mode == "rigid":
+        import numpy as np
+        case, time, inner = sys.argv[2], sys.argv[3], float(sys.argv[4])
+        twoD = "--2d" in sys.argv
+        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        p0, p1 = np.array(pointsAt(case, "constant")), np.array(pointsAt(case, time))
+        inf = np.abs(p0[:, :2 if twoD else 3] - 0.5).max(axis=1)
+        hole = np.abs(inf - 0.15) < 1e-12
+        # the hole's rigid motion x -> R x + t (Kabsch fit on its points)
+        a, b = p0[hole], p1[hole]
+        ca, cb = a.mean(axis=0), b.mean(axis=0)
+        u, _, vt = np.linalg.svd((a - ca).T @ (b - cb))
+        s = np.diag([1, 1, np.sign(np.linalg.det(vt.T @ u.T))])
+        R = vt.T @ s @ u.T
+        t = cb - R @ ca
+        fit = np.abs(b - (a @ R.T + t)).max()
+        angle = np.degrees(np.arccos(min(1.0, (np.trace(R) - 1)/2)))
+        check(fit <= tol, "the hole moved rigidly (%d points, turned %.2f deg, fit error %.2e)"
+              % (hole.sum(), angle, fit))
+        dist = np.sqrt(((p0[:, None, :] - a[None, :, :])**2).sum(axis=2)).min(axis=1)
+        zone = (dist < inner) & ~hole
+        err = np.abs(p1[zone] - (p0[zone] @ R.T + t)).max(axis=1)
+        check(zone.sum() > 0 and err.max() <= tol,
+              "%d points within %g of the hole moved with it: largest error %.2e" % (zone.sum(), inner, err.max()))
+        far = dist > 2*inner
+        farErr = np.abs(p1[far] - (p0[far] @ R.T + t)).max()
+        check(farErr > 1e-3, "points further out do not (largest departure %.3g)" % farErr)
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv

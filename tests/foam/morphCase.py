@@ -21,6 +21,10 @@ ap.add_argument("--np", type=int, default=1)
 ap.add_argument("--end", type=int, default=3)
 ap.add_argument("--merge-sides", action="store_true", help="one slip patch for the four x/y faces")
 ap.add_argument("--move", type=float, default=0.06, help="x displacement of the hole at t=3")
+ap.add_argument("--rotate", type=float, default=None, metavar="DEG",
+                help="turn the hole rigidly about the z axis through (0.45 0.5 0.5) by DEG at the end time instead")
+ap.add_argument("--rigid-layers", type=float, nargs=2, default=None, metavar=("INNER", "OUTER"),
+                help="rigidLayers on the hole with these inner and outer distances")
 a = ap.parse_args()
 
 X = [0.0, 0.35, 0.65, 1.0]
@@ -111,7 +115,10 @@ write("system/fvSolution", "dictionary", "fvSolution",
 write("system/decomposeParDict", "dictionary", "decomposeParDict",
       "numberOfSubdomains %d; method hierarchical; coeffs { n (%d 1 1); order xyz; }" % (a.np, a.np))
 
-coeffs = {"multilevelBSpline": "multilevelBSplineCoeffs { tolerance 1e-10; }",
+layers = ("rigidLayers { patches (hole); innerDistance %.17g; outerDistance %.17g; }" % tuple(a.rigid_layers)
+          if a.rigid_layers else "")
+coeffs = {"multilevelBSpline": "multilevelBSplineCoeffs { tolerance 1e-10; %s }" % layers,
+          "RBF": "RBFCoeffs { %s }" % layers,
           "displacementLaplacian": "displacementLaplacianCoeffs { diffusivity quadratic inverseDistance 1 (hole); }"}
 libs = '("libbsplineMorph.so")' if a.solver != "displacementLaplacian" else '("libfvMotionSolvers.so")'
 write("constant/dynamicMeshDict", "dictionary", "dynamicMeshDict",
@@ -123,6 +130,10 @@ bc = {"hole": "type uniformFixedValue; uniformValue table ((0 (0 0 0)) (3 %s));"
       "xMin": "type slip;", "xMax": "type slip;", "yMin": "type slip;", "yMax": "type slip;",
       "zMin": "type fixedValue; value uniform (0 0 0);", "zMax": "type fixedValue; value uniform (0 0 0);",
       "frontAndBack": "type empty;", "sides": "type slip;"}
+if a.rotate is not None:
+    bc["hole"] = ("type solidBodyMotionDisplacement; solidBodyMotionFunction rotatingMotion; "
+                  "rotatingMotionCoeffs { solidBodyMotionFunction rotatingMotion; origin (0.45 0.5 0.5); "
+                  "axis (0 0 1); omega %.17g; } value uniform (0 0 0);" % (a.rotate*3.141592653589793/180/a.end))
 if a.twoD:
     bc["xMin"] = bc["xMax"] = "type fixedValue; value uniform (0 0 0);"
 body = "dimensions [0 1 0 0 0 0 0];\ninternalField uniform (0 0 0);\nboundaryField {\n"

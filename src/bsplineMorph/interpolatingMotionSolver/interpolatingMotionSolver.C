@@ -169,6 +169,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     planned_{false, false},
     slot_(0)
 {}
@@ -185,6 +186,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     planned_{false, false},
     slot_(0)
 {}
@@ -274,6 +276,25 @@ void Foam::interpolatingMotionSolver::solve()
             use(1, refitChanged);
             summary += "; re-fit with the projected sliding points: " + interpolateInto(displacement);
             slot_ = 0;
+        }
+
+        // The layers near the listed walls move with them (from the walls'
+        // final displacement: the boundary points constrained first)
+        if (rigidLayersPtr_)
+        {
+            if (changed)
+            {
+                rigidLayersPtr_->checkConstrained(*constraintsPtr_);
+            }
+            constraintsPtr_->constrain(displacement);
+            rigidLayersPtr_->apply
+            (
+                p0,
+                constraintsPtr_->fixed(),
+                constraintsPtr_->directions(),
+                displacement,
+                newPoints_
+            );
         }
     }
     // The points the conditions fix or constrain (the interpolated ones
@@ -418,7 +439,11 @@ void Foam::interpolatingMotionSolver::movePoints(const pointField& p)
 void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
 {
     displacementMotionSolver::updateMesh(mpm);
-    // points0 changed: the plan is rebuilt at the next solve
+    // points0 changed: the plans are rebuilt at the next solve
+    if (rigidLayersPtr_)
+    {
+        rigidLayersPtr_->clearPlan();
+    }
     constraintsPtr_.reset();
     refitPtr_.reset();
     evalPoints_.clear();

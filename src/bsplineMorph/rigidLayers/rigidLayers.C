@@ -1,0 +1,532 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "rigidLayers.H"
+#include "boundaryConstraints.H"
+#include "emptyPolyPatch.H"
+#include "syncTools.H"
+#include "globalIndex.H"
+#include "bitSet.H"
+#include "PstreamBuffers.H"
+#include "HashOps.H"
+#include "wordRes.H"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
+
+namespace Foam
+{
+namespace
+{
+    //- Twice the area vector of a face of the given points (the triangles
+    //  about its first vertex)
+    vector twiceArea(const face& f, const pointField& p0, const vectorField* u)
+    {
+        const point a = u ? p0[f[0]] + (*u)[f[0]] : p0[f[0]];
+        vector area(Zero);
+        point b = u ? p0[f[1]] + (*u)[f[1]] : p0[f[1]];
+        for (label i = 2; i < f.size(); ++i)
+        {
+            const point c = u ? p0[f[i]] + (*u)[f[i]] : p0[f[i]];
+            area += (b - a) ^ (c - a);
+            b = c;
+        }
+        return area;
+    }
+
+    //- Squared distance from a point to a box (0 inside; large for an
+    //  empty box)
+    scalar distSqrToBox(const point& p, const boundBox& bb)
+    {
+        if (bb.empty())
+        {
+            return GREAT;
+        }
+        scalar s = 0;
+        for (direction d = 0; d < 3; ++d)
+        {
+            const scalar below = bb.min()[d] - p[d];
+            const scalar above = p[d] - bb.max()[d];
+            const scalar out = max(below, above);
+            if (out > 0)
+            {
+                s += out*out;
+            }
+        }
+        return s;
+    }
+
+    //- A candidate foot: a wall point of this or another rank
+    struct footCandidate
+    {
+        label globalIndex;
+        point x;
+        bool local;
+    };
+
+    //- Whether foot a is preferred to foot b at the same squared distance:
+    //  the lexicographically smaller point, then a copy on this rank (the
+    //  same point on two ranks has the same transform)
+    bool preferred(const footCandidate& a, const footCandidate& b)
+    {
+        for (direction d = 0; d < 3; ++d)
+        {
+            if (a.x[d] != b.x[d])
+            {
+                return a.x[d] < b.x[d];
+            }
+        }
+        return a.local && !b.local;
+    }
+}
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
+:
+    mesh_(mesh),
+    dict_(dict),
+    innerDistance_(0),
+    outerDistance_(0),
+    planned_(false)
+{
+    // Patches: every pattern must match a patch that can carry layers
+    const wordRes patterns(dict.get<wordRes>("patches"));
+    const polyBoundaryMesh& pbm = mesh.boundaryMesh();
+    DynamicList<word> valid;
+    forAll(pbm, patchi)
+    {
+        if (!pbm[patchi].coupled() && !isA<emptyPolyPatch>(pbm[patchi]))
+        {
+            valid.append(pbm[patchi].name());
+        }
+    }
+    labelHashSet ids;
+    for (const wordRe& pattern : patterns)
+    {
+        bool found = false;
+        forAll(pbm, patchi)
+        {
+            const polyPatch& pp = pbm[patchi];
+            if (!pp.coupled() && !isA<emptyPolyPatch>(pp) && pattern.match(pp.name()))
+            {
+                ids.insert(patchi);
+                found = true;
+            }
+        }
+        if (!found)
+        {
+            FatalIOErrorInFunction(dict)
+                << "patches: " << pattern << " matches no patch that can carry"
+                << " rigid layers (coupled and empty patches cannot); valid patches: "
+                << flatOutput(valid) << exit(FatalIOError);
+        }
+    }
+    patchIDs_ = ids.sortedToc();
+
+    innerDistance_ = dict.getCheck<scalar>("innerDistance", scalarMinMax::ge(0));
+    outerDistance_ = dict.getCheck<scalar>("outerDistance", scalarMinMax::ge(0));
+    if (!(outerDistance_ > innerDistance_))
+    {
+        FatalIOErrorInFunction(dict)
+            << "outerDistance " << outerDistance_ << " must be larger than"
+            << " innerDistance " << innerDistance_ << " (the blend lies between"
+            << " them)" << exit(FatalIOError);
+    }
+}
+
+
+// * * * * * * * * * * * * * * * * Selectors * * * * * * * * * * * * * * * * //
+
+Foam::autoPtr<Foam::rigidLayers> Foam::rigidLayers::New
+(
+    const polyMesh& mesh,
+    const dictionary& coeffDict
+)
+{
+    if (!coeffDict.found("rigidLayers"))
+    {
+        return nullptr;
+    }
+    if (!coeffDict.isDict("rigidLayers"))
+    {
+        FatalIOErrorInFunction(coeffDict)
+            << "rigidLayers must be a dictionary { patches (...); innerDistance"
+            << " ...; outerDistance ...; }" << exit(FatalIOError);
+    }
+    return autoPtr<rigidLayers>::New(mesh, coeffDict.subDict("rigidLayers"));
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::scalar Foam::rigidLayers::weight
+(
+    const scalar d,
+    const scalar inner,
+    const scalar outer
+)
+{
+    if (d <= inner)
+    {
+        return 1;
+    }
+    if (d >= outer)
+    {
+        return 0;
+    }
+    const scalar t = (outer - d)/(outer - inner);
+    return t*t*t*(t*(6*t - 15) + 10);
+}
+
+
+Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
+{
+    // Newton's iteration for the polar decomposition, X <- (g X + X^-T/g)/2
+    // with the determinant scaling g = |det X|^(-1/3) (Higham): quadratic
+    // convergence to the orthogonal factor; M scaled to unit size first
+    const scalar size = mag(M);
+    if (!(size > 0))
+    {
+        return tensor::I;
+    }
+    tensor X = M/size;
+    if (!(det(X) > 1e-12))
+    {
+        return tensor::I;
+    }
+    for (label iter = 0; iter < 100; ++iter)
+    {
+        const scalar g = std::cbrt(1/det(X));
+        const tensor next = 0.5*(g*X + inv(X).T()/g);
+        const scalar change = mag(next - X);
+        X = next;
+        if (change < 1e-14)
+        {
+            break;
+        }
+    }
+    // One more unscaled step: orthogonal to round-off
+    return 0.5*(X + inv(X).T());
+}
+
+
+void Foam::rigidLayers::plan(const pointField& points0)
+{
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    const label myProc = Pstream::myProcNo();
+
+    // The wall points, and where each listed patch's points are among them
+    bitSet onWall(mesh_.nPoints());
+    for (const label patchi : patchIDs_)
+    {
+        onWall.set(pbm[patchi].meshPoints());
+    }
+    wallPoints_ = onWall.sortedToc();
+    const label nWall = wallPoints_.size();
+    Map<label> wallOf(2*nWall);
+    forAll(wallPoints_, i)
+    {
+        wallOf.insert(wallPoints_[i], i);
+    }
+    patchWall_.setSize(patchIDs_.size());
+    forAll(patchIDs_, k)
+    {
+        const labelList& meshPoints = pbm[patchIDs_[k]].meshPoints();
+        patchWall_[k].setSize(meshPoints.size());
+        forAll(meshPoints, i)
+        {
+            patchWall_[k][i] = wallOf[meshPoints[i]];
+        }
+    }
+    const globalIndex wallIndex(nWall);
+
+    // Candidate feet: this rank's wall points and those of the other ranks
+    // within outerDistance of this rank's points
+    const scalar outer = outerDistance_;
+    List<boundBox> rankBox(Pstream::nProcs());
+    rankBox[myProc] = boundBox(points0, false);
+    Pstream::gatherList(rankBox);
+    Pstream::scatterList(rankBox);
+
+    std::vector<footCandidate> cand;
+    cand.reserve(nWall);
+    forAll(wallPoints_, i)
+    {
+        cand.push_back({wallIndex.toGlobal(i), points0[wallPoints_[i]], true});
+    }
+    if (Pstream::parRun())
+    {
+        PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
+        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
+        {
+            if (proci == myProc)
+            {
+                continue;
+            }
+            DynamicList<label> ids;
+            DynamicList<point> xs;
+            forAll(wallPoints_, i)
+            {
+                const point& x = points0[wallPoints_[i]];
+                if (distSqrToBox(x, rankBox[proci]) <= outer*outer)
+                {
+                    ids.append(wallIndex.toGlobal(i));
+                    xs.append(x);
+                }
+            }
+            UOPstream os(proci, buffers);
+            os << ids << xs;
+        }
+        buffers.finishedSends();
+        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
+        {
+            if (proci == myProc)
+            {
+                continue;
+            }
+            UIPstream is(proci, buffers);
+            labelList ids;
+            List<point> xs;
+            is >> ids >> xs;
+            forAll(ids, i)
+            {
+                cand.push_back({ids[i], xs[i], false});
+            }
+        }
+    }
+
+    // Bins of size outerDistance: every candidate within outerDistance of a
+    // point lies in the point's bin or one of its 26 neighbours
+    const scalar h = outer;
+    const point origin = rankBox[myProc].empty() ? point::zero : rankBox[myProc].min();
+    auto binOf = [&](const point& x, const int o0, const int o1, const int o2)
+    {
+        const std::int64_t i = std::int64_t(std::floor((x.x() - origin.x())/h)) + o0;
+        const std::int64_t j = std::int64_t(std::floor((x.y() - origin.y())/h)) + o1;
+        const std::int64_t k = std::int64_t(std::floor((x.z() - origin.z())/h)) + o2;
+        return std::uint64_t(((i & 0x1fffff) << 42) | ((j & 0x1fffff) << 21) | (k & 0x1fffff));
+    };
+    std::unordered_map<std::uint64_t, std::vector<label>> bins;
+    for (std::size_t c = 0; c < cand.size(); ++c)
+    {
+        bins[binOf(cand[c].x, 0, 0, 0)].push_back(label(c));
+    }
+
+    // Each point's foot: the nearest candidate (ties: preferred())
+    DynamicList<label> zone, feet;
+    DynamicList<scalar> weights;
+    DynamicList<vector> arms;
+    const scalar outerSqr = outer*outer;
+    forAll(points0, pointi)
+    {
+        const point& x = points0[pointi];
+        label best = -1;
+        scalar bestSqr = outerSqr;
+        for (int o0 = -1; o0 <= 1; ++o0)
+        for (int o1 = -1; o1 <= 1; ++o1)
+        for (int o2 = -1; o2 <= 1; ++o2)
+        {
+            const auto bin = bins.find(binOf(x, o0, o1, o2));
+            if (bin == bins.end())
+            {
+                continue;
+            }
+            for (const label c : bin->second)
+            {
+                const scalar s = magSqr(x - cand[c].x);
+                if
+                (
+                    s < bestSqr
+                 || (s == bestSqr && best >= 0 && preferred(cand[c], cand[best]))
+                )
+                {
+                    best = c;
+                    bestSqr = s;
+                }
+            }
+        }
+        if (best >= 0)
+        {
+            zone.append(pointi);
+            feet.append(cand[best].globalIndex);
+            weights.append(weight(std::sqrt(bestSqr), innerDistance_, outer));
+            arms.append(x - cand[best].x);
+        }
+    }
+    zonePoints_.transfer(zone);
+    zoneFoot_.transfer(feet);
+    zoneWeight_.transfer(weights);
+    zoneArm_.transfer(arms);
+
+    // The feet in compact numbering: this rank's wall points, then the other
+    // ranks' that are feet here
+    List<Map<label>> compactMap;
+    mapPtr_.reset(new mapDistribute(wallIndex, zoneFoot_, compactMap));
+    planned_ = true;
+
+    const wordList patchNames(pbm.names(), patchIDs_);
+    const label nInner = std::count(zoneWeight_.begin(), zoneWeight_.end(), scalar(1));
+    Info<< "rigidLayers: " << returnReduce(zonePoints_.size(), sumOp<label>())
+        << " points within outerDistance " << outerDistance_ << " of "
+        << returnReduce(nWall, sumOp<label>()) << " wall points on patches "
+        << flatOutput(patchNames)
+        << " (" << returnReduce(nInner, sumOp<label>())
+        << " within innerDistance " << innerDistance_ << ")" << endl;
+}
+
+
+void Foam::rigidLayers::fitRotations
+(
+    const pointField& points0,
+    const vectorField& displacement
+)
+{
+    // Per wall point: M = sum over its faces on the listed patches of
+    // e1 e0^T over the face's edges and A1 A0^T/|A0| (A: area vector;
+    // 0: points0, 1: moved); a rigid motion R gives M = R S, S symmetric
+    // positive definite, whose polar factor is R
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    const label nWall = wallPoints_.size();
+    rotation_.setSize(nWall);
+    rotation_ = Zero;
+    forAll(patchIDs_, k)
+    {
+        const polyPatch& pp = pbm[patchIDs_[k]];
+        const faceList& localFaces = pp.localFaces();
+        forAll(pp, facei)
+        {
+            const face& f = pp[facei];
+            tensor M(Zero);
+            forAll(f, k)
+            {
+                const label a = f[k];
+                const label b = f.nextLabel(k);
+                const vector e0 = points0[b] - points0[a];
+                const vector e1 = e0 + displacement[b] - displacement[a];
+                M += e1*e0;
+            }
+            const vector A0 = twiceArea(f, points0, nullptr);
+            const vector A1 = twiceArea(f, points0, &displacement);
+            M += (A1*A0)/(mag(A0) + VSMALL);
+            for (const label lp : localFaces[facei])
+            {
+                rotation_[patchWall_[k][lp]] += M;
+            }
+        }
+    }
+    // The sums of the ranks that share a point, the same on all of them
+    syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
+    for (tensor& R : rotation_)
+    {
+        R = rotation(R);
+    }
+}
+
+
+void Foam::rigidLayers::checkConstrained(const boundaryConstraints& bc) const
+{
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    wordHashSet loose;
+    for (const label patchi : patchIDs_)
+    {
+        for (const label pointi : pbm[patchi].meshPoints())
+        {
+            if (!bc.constrains(pointi))
+            {
+                loose.insert(pbm[patchi].name());
+                break;
+            }
+        }
+    }
+    Pstream::combineGather(loose, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(loose);
+    if (loose.size())
+    {
+        FatalIOErrorInFunction(dict_)
+            << "patches: the boundary conditions of pointDisplacement neither"
+            << " fix nor slide the points of " << flatOutput(loose.sortedToc())
+            << "; rigid layers follow walls whose motion is prescribed"
+            << " (fixedValue, uniformFixedValue, solidBodyMotionDisplacement,"
+            << " ...) or that slide (slip, symmetryPlane, ...)"
+            << exit(FatalIOError);
+    }
+}
+
+
+void Foam::rigidLayers::apply
+(
+    const pointField& points0,
+    const boolList& fixed,
+    const labelList& dirs,
+    vectorField& displacement,
+    pointField& newPoints
+)
+{
+    if (!planned_)
+    {
+        plan(points0);
+    }
+    fitRotations(points0, displacement);
+    footDisplacement_ = vectorField(displacement, wallPoints_);
+    mapPtr_->distribute(rotation_);
+    mapPtr_->distribute(footDisplacement_);
+
+    bool solved[3] = {false, false, false};
+    for (const label d : dirs)
+    {
+        solved[d] = true;
+    }
+    forAll(zonePoints_, i)
+    {
+        const label pointi = zonePoints_[i];
+        if (fixed[pointi])
+        {
+            continue;
+        }
+        const label j = zoneFoot_[i];
+        const vector& arm = zoneArm_[i];
+        vector rigid = footDisplacement_[j] + (rotation_[j] & arm) - arm;
+        const scalar w = zoneWeight_[i];
+        vector& d = displacement[pointi];
+        if (w < 1)
+        {
+            rigid = d + w*(rigid - d);
+        }
+        for (direction c = 0; c < 3; ++c)
+        {
+            d[c] = solved[c] ? rigid[c] : 0;
+        }
+        newPoints[pointi] = points0[pointi] + d;
+    }
+}
+
+
+Foam::label Foam::rigidLayers::nZonePointsGlobal() const
+{
+    return returnReduce(zonePoints_.size(), sumOp<label>());
+}
+
+
+// ************************************************************************* //
