@@ -10,6 +10,8 @@
 #include "communicatorConformance.hpp"
 #include "PstreamCommunicator.H"
 #include "multilevelBSplineMotionSolver.H"
+#include "rigidLayers.H"
+#include "quaternion.H"
 #include "IStringStream.H"
 #include "IOdictionary.H"
 #include "fvMesh.H"
@@ -190,4 +192,80 @@ TEST_CASE("RBF: the defaults keep a mesh whose walls are fixed at zero", "[foam]
     REQUIRE(solver.valid());
     CHECK(solver->type() == "RBF");
     requireUnmoved(solver.ref(), 1e-12);
+}
+
+
+TEST_CASE("rigidLayers: bad input names the entry and the valid choices", "[foam][rigidLayers][errors]")
+{
+    using Catch::Matchers::Contains;
+    const std::string unknown =
+        errorOf("rigidLayers { patches (wall); innerDistance 0.1; outerDistance 0.2; }");
+    CHECK_THAT(unknown, Contains("patches") && Contains("wall") && Contains("walls"));
+    CHECK(errorOf("rigidLayers { patches (walls); innerDistance 0.1; outerDistance 0.2; }", "RBF") == "no error");
+    CHECK_THAT
+    (
+        errorOf("rigidLayers { patches (walls); innerDistance 0.2; outerDistance 0.2; }"),
+        Contains("outerDistance") && Contains("innerDistance")
+    );
+    CHECK_THAT
+    (
+        errorOf("rigidLayers { patches (walls); innerDistance -0.1; outerDistance 0.2; }"),
+        Contains("innerDistance")
+    );
+    CHECK_THAT
+    (
+        errorOf("rigidLayers { patches (walls); innerDistance 0.1; }", "RBF"),
+        Contains("outerDistance")
+    );
+    CHECK_THAT(errorOf("rigidLayers (walls);"), Contains("rigidLayers"));
+    CHECK(errorOf("rigidLayers { patches (\"w.*\"); innerDistance 0; outerDistance 0.2; }") == "no error");
+}
+
+
+TEST_CASE("rigidLayers: the blend weight is 1 inside, 0 outside and C2 between", "[foam][rigidLayers]")
+{
+    const scalar inner = 0.1, outer = 0.4;
+    const auto w = [&](const scalar d) { return rigidLayers::weight(d, inner, outer); };
+    CHECK(w(0) == 1);
+    CHECK(w(inner) == 1);
+    CHECK(w(outer) == 0);
+    CHECK(w(1) == 0);
+    CHECK(w(0.5*(inner + outer)) == Approx(0.5).margin(1e-15));
+    // Monotone, and value, slope and curvature continuous at both ends: the
+    // one-sided differences there are far below what the blend has inside
+    // (a cubic smoothstep, C1 only, has curvature 6/(outer - inner)^2 there)
+    scalar last = 1;
+    for (label i = 0; i <= 1000; ++i)
+    {
+        const scalar v = w(inner + (outer - inner)*i/1000.0);
+        REQUIRE(v <= last);
+        last = v;
+    }
+    for (const scalar end : {inner, outer})
+    {
+        const scalar side = end == inner ? 1 : -1;
+        const scalar h = 1e-4*(outer - inner);
+        const scalar slope = (w(end + side*h) - w(end))/h;
+        const scalar curvature = (w(end + 2*side*h) - 2*w(end + side*h) + w(end))/(h*h);
+        CHECK(std::abs(slope) < 1e-4);
+        CHECK(std::abs(curvature) < 1e-2*6/sqr(outer - inner));
+    }
+}
+
+
+TEST_CASE("rigidLayers: the fitted rotation is the rotation of a rigid map", "[foam][rigidLayers]")
+{
+    // M = R S with S symmetric positive definite: the polar factor is R
+    const quaternion q(vector(1, -2, 0.5)/mag(vector(1, -2, 0.5)), 0.9);
+    const tensor R = q.R();
+    const tensor S(2, 0.3, 0.1, 0.3, 1, -0.2, 0.1, -0.2, 0.5);
+    const tensor Q = rigidLayers::rotation(R & S);
+    CHECK(mag(Q - R) < 1e-14);
+    CHECK(mag(rigidLayers::rotation(1e-9*S) - tensor::I) < 1e-14);
+    // Flat S (a plane of edges and its normal, as on a wall face) too
+    const tensor flat(1, 0, 0, 0, 1, 0, 0, 0, 1e-3);
+    CHECK(mag(rigidLayers::rotation(R & flat) - R) < 1e-13);
+    // A mirror or a singular map has no rotation: identity
+    CHECK(rigidLayers::rotation(tensor(-1, 0, 0, 0, 1, 0, 0, 0, 1)) == tensor::I);
+    CHECK(rigidLayers::rotation(tensor::zero) == tensor::I);
 }

@@ -82,6 +82,9 @@ def main():
         far = dist > 2*inner
         farErr = np.abs(p1[far] - (p0[far] @ R.T + t)).max()
         check(farErr > 1e-3, "points further out do not (largest departure %.3g)" % farErr)
+        if twoD:
+            zErr = np.abs(p1[:, 2] - p0[:, 2]).max()
+            check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv
