@@ -38,15 +38,33 @@ Description
       angle between the wall normal and the face-to-cell-centre direction
       [deg]: mean and worst (largest magnitude) of each.
 
+    With -layers N (N > 0) the same two measures for each of the first N
+    prism layers, printed as a table and appended to
+    postProcessing/morphQualityLayers.dat (one row per time and layer: time
+    layer nCells meanHeightChange worstHeightChange meanAngleChange
+    worstAngleChange). A column of layer cells starts at each wall face:
+    layer 1 is its owner cell, and the face of a layer cell opposite to its
+    bottom face (hex and prism cells) is the bottom face of the next layer's
+    cell. The column stops at a cell without an opposite face and at a
+    boundary face, except processor and cyclic faces, across which it goes on
+    (not across cyclicAMI). A layer cell's height is its volume / its bottom
+    face's area, its angle the one between that face's normal (into the
+    cell) and the face-to-cell-centre direction; layer 1 gives the
+    first-layer measures above. A cell in two columns (near the corner of two
+    walls) counts in each.
+
     Works in parallel (-parallel, on the decomposed case). The mesh topology
     must be the one in constant/polyMesh (a morph moves points only).
 
 Usage
     \verbatim
-    morphQuality [-patches '(sphere)'] [-time ... | -latestTime] [-parallel]
+    morphQuality [-patches '(sphere)'] [-layers N] [-time ... | -latestTime]
+        [-parallel]
     \endverbatim
     -patches    wall patches for the boundary-layer measures (default: every
                 patch of type wall)
+    -layers     number of prism layers to measure one by one (default 0: the
+                first-layer measures only, no morphQualityLayers.dat)
 
 \*---------------------------------------------------------------------------*/
 
@@ -59,10 +77,13 @@ Usage
 #include "primitiveMeshTools.H"
 #include "syncTools.H"
 #include "wallPolyPatch.H"
+#include "processorPolyPatch.H"
+#include "cyclicPolyPatch.H"
 #include "OFstream.H"
 #include "OSspecific.H"
 #include "pyramidPointFaceRef.H"
 #include "unitConversion.H"
+#include "IOmanip.H"
 
 using namespace Foam;
 
@@ -75,8 +96,13 @@ struct layerGeometry
     scalarField angle;      // wall normal vs face-to-centre [deg]
 };
 
-// The first-layer cells' geometry on the given wall faces
-layerGeometry firstLayer(const polyMesh& mesh, const labelList& faces)
+// The geometry of layer cells on their bottom faces (faces[i] of cells[i])
+layerGeometry cellsOnFaces
+(
+    const polyMesh& mesh,
+    const labelList& faces,
+    const labelList& cells
+)
 {
     layerGeometry g;
     g.height.setSize(faces.size());
@@ -88,11 +114,107 @@ layerGeometry firstLayer(const polyMesh& mesh, const labelList& faces)
     forAll(faces, i)
     {
         const label facei = faces[i];
-        const label celli = mesh.faceOwner()[facei];
-        const vector inward = -Sf[facei]/(mag(Sf[facei]) + VSMALL);
+        const label celli = cells[i];
+        // the face normal into the cell (a wall face's cell is its owner)
+        const vector inward =
+            (mesh.faceOwner()[facei] == celli ? -Sf[facei] : Sf[facei])
+           /(mag(Sf[facei]) + VSMALL);
         const vector d = C[celli] - Cf[facei];
         g.height[i] = V[celli]/(mag(Sf[facei]) + VSMALL);
         g.angle[i] = radToDeg(Foam::acos(min(1.0, max(-1.0, (d & inward)/(mag(d) + VSMALL)))));
+    }
+    return g;
+}
+
+// The first-layer cells' geometry on the given wall faces
+layerGeometry firstLayer(const polyMesh& mesh, const labelList& faces)
+{
+    return cellsOnFaces(mesh, faces, labelList(UIndirectList<label>(mesh.faceOwner(), faces)));
+}
+
+// Prism layer k (0-based): the cells and their bottom faces on this rank
+struct layerCells
+{
+    labelList faces;
+    labelList cells;
+};
+
+// The first nLayers layers of the columns on the wall faces (see the
+// description). Layer by layer: a column leaving through a processor or
+// cyclic face goes on in the cell on its other side, so each layer cell is on
+// the rank that holds it, once per column.
+List<layerCells> walkLayers
+(
+    const polyMesh& mesh,
+    const labelList& wallFaces,
+    const label nLayers
+)
+{
+    const faceList& faces = mesh.faces();
+    const cellList& cells = mesh.cells();
+    const labelList& own = mesh.faceOwner();
+    const labelList& nei = mesh.faceNeighbour();
+    const polyBoundaryMesh& patches = mesh.boundaryMesh();
+    const label nInternal = mesh.nInternalFaces();
+
+    List<layerCells> layers(nLayers);
+    if (nLayers <= 0) return layers;
+    layers[0].faces = wallFaces;
+    layers[0].cells = labelList(UIndirectList<label>(own, wallFaces));
+
+    for (label k = 1; k < nLayers; ++k)
+    {
+        const layerCells& below = layers[k - 1];
+        DynamicList<label> nextFaces(below.faces.size());
+        DynamicList<label> nextCells(below.faces.size());
+        // 1 on the processor and cyclic faces the columns leave through
+        // (the coupled faces syncTools swaps: not cyclicAMI)
+        labelList leaving(mesh.nBoundaryFaces(), 0);
+        forAll(below.faces, i)
+        {
+            const label celli = below.cells[i];
+            const label topi = cells[celli].opposingFaceLabel(below.faces[i], faces);
+            if (topi < 0)
+            {
+                continue;   // not a hex or prism seen from this face
+            }
+            if (topi < nInternal)
+            {
+                nextFaces.append(topi);
+                nextCells.append(own[topi] == celli ? nei[topi] : own[topi]);
+            }
+            else if
+            (
+                isA<processorPolyPatch>(patches[patches.whichPatch(topi)])
+             || isA<cyclicPolyPatch>(patches[patches.whichPatch(topi)])
+            )
+            {
+                leaving[topi - nInternal] = 1;
+            }
+        }
+        // the other side's columns that enter here
+        syncTools::swapBoundaryFaceList(mesh, leaving);
+        forAll(leaving, bFacei)
+        {
+            if (leaving[bFacei])
+            {
+                nextFaces.append(nInternal + bFacei);
+                nextCells.append(own[nInternal + bFacei]);
+            }
+        }
+        layers[k].faces.transfer(nextFaces);
+        layers[k].cells.transfer(nextCells);
+    }
+    return layers;
+}
+
+// The geometry of each layer's cells
+List<layerGeometry> layersGeometry(const polyMesh& mesh, const List<layerCells>& layers)
+{
+    List<layerGeometry> g(layers.size());
+    forAll(layers, k)
+    {
+        g[k] = cellsOnFaces(mesh, layers[k].faces, layers[k].cells);
     }
     return g;
 }
@@ -171,20 +293,24 @@ labelHashSet invalidCells(const polyMesh& mesh, const measures& m)
     return bad;
 }
 
-// mean and worst (largest magnitude) of a field over all ranks
+// mean of the magnitude and worst (largest magnitude) of a field over all
+// ranks
 void meanWorst(const scalarField& f, scalar& mean, scalar& worst)
 {
-    scalar sum = 0, w = 0;
+    scalar sum = 0, hi = 0, lo = 0;
     for (const scalar v : f)
     {
         sum += mag(v);
-        if (mag(v) > mag(w)) w = v;
+        if (v > hi) hi = v;
+        if (v < lo) lo = v;
     }
     const label n = returnReduce(f.size(), sumOp<label>());
     mean = returnReduce(sum, sumOp<scalar>())/max(n, 1);
-    // the signed value of largest magnitude
-    const scalar wMax = returnReduce(w, maxOp<scalar>());
-    const scalar wMin = returnReduce(w, minOp<scalar>());
+    // the signed value of largest magnitude, from the largest and the
+    // smallest value: independent of the order of the values and ranks (the
+    // positive one of a tie)
+    const scalar wMax = returnReduce(hi, maxOp<scalar>());
+    const scalar wMin = returnReduce(lo, minOp<scalar>());
     worst = mag(wMax) >= mag(wMin) ? wMax : wMin;
 }
 
@@ -204,6 +330,12 @@ int main(int argc, char *argv[])
         "patches",
         "wordRes",
         "Wall patches for the boundary-layer measures (default: all walls)"
+    );
+    argList::addOption
+    (
+        "layers",
+        "N",
+        "Measure the first N prism layers one by one (default 0: off)"
     );
     #include "setRootCase.H"
     #include "createTime.H"
@@ -239,6 +371,13 @@ int main(int argc, char *argv[])
         forAll(patches[patchi], i) wallFaceList.append(patches[patchi].start() + i);
     }
     const labelList wallFaces(wallFaceList);
+    const label nLayers = args.getOrDefault<label>("layers", 0);
+    if (nLayers < 0)
+    {
+        FatalErrorInFunction
+            << "-layers " << nLayers << ": expected N >= 0" << exit(FatalError);
+    }
+    const List<layerCells> layers(walkLayers(mesh, wallFaces, nLayers));
 
     // The undeformed mesh
     pointIOField points0
@@ -257,6 +396,7 @@ int main(int argc, char *argv[])
     mesh.movePoints(points0);
     const scalarField V0(mesh.cellVolumes());
     const layerGeometry layer0(firstLayer(mesh, wallFaces));
+    const List<layerGeometry> layers0(layersGeometry(mesh, layers));
 
     Info<< "Undeformed mesh: " << returnReduce(mesh.nCells(), sumOp<label>())
         << " cells; boundary-layer measures on " << flatOutput(wallNames)
@@ -274,6 +414,20 @@ int main(int argc, char *argv[])
             << "# time maxNonOrth maxSkewness minDeterminant minVolRatio maxVolRatio nInvalid"
             << " meanLayerHeightChange worstLayerHeightChange meanLayerAngleChange worstLayerAngleChange"
             << nl;
+    }
+    autoPtr<OFstream> layersOsPtr;
+    if (Pstream::master() && nLayers > 0)
+    {
+        layersOsPtr.reset
+        (
+            new OFstream(runTime.globalPath()/"postProcessing"/"morphQualityLayers.dat")
+        );
+        layersOsPtr()
+            << "# morphQuality -layers " << nLayers
+            << ": against constant/polyMesh/points; prism layers on "
+            << flatOutput(wallNames) << "; angles in deg" << nl
+            << "# time layer nCells meanHeightChange worstHeightChange"
+            << " meanAngleChange worstAngleChange" << nl;
     }
 
     forAll(timeDirs, timei)
@@ -342,11 +496,45 @@ int main(int argc, char *argv[])
                 << ' ' << minRatio << ' ' << maxRatio << ' ' << nInvalid
                 << ' ' << hMean << ' ' << hWorst << ' ' << aMean << ' ' << aWorst << nl;
         }
+
+        // Each prism layer
+        if (nLayers > 0)
+        {
+            Info<< "    prism layers" << nl
+                << "    " << setw(5) << "layer" << ' ' << setw(7) << "nCells"
+                << ' ' << setw(24) << "meanHeightChange" << ' ' << setw(24) << "worstHeightChange"
+                << ' ' << setw(24) << "meanAngleChange" << ' ' << setw(24) << "worstAngleChange"
+                << nl;
+        }
+        forAll(layers, k)
+        {
+            const layerGeometry g(cellsOnFaces(mesh, layers[k].faces, layers[k].cells));
+            const label n = returnReduce(layers[k].cells.size(), sumOp<label>());
+            meanWorst(g.height/layers0[k].height - 1, hMean, hWorst);
+            meanWorst(g.angle - layers0[k].angle, aMean, aWorst);
+            Info<< "    " << setw(5) << k + 1 << ' ' << setw(7) << n
+                << ' ' << setw(24) << hMean << ' ' << setw(24) << hWorst
+                << ' ' << setw(24) << aMean << ' ' << setw(24) << aWorst << nl;
+            if (layersOsPtr.valid())
+            {
+                layersOsPtr()
+                    << runTime.timeName() << ' ' << k + 1 << ' ' << n
+                    << ' ' << hMean << ' ' << hWorst << ' ' << aMean << ' ' << aWorst << nl;
+            }
+        }
+        if (nLayers > 0)
+        {
+            Info<< endl;
+        }
     }
 
     if (osPtr.valid())
     {
         Info<< "Table: " << osPtr().name() << endl;
+    }
+    if (layersOsPtr.valid())
+    {
+        Info<< "Layers table: " << layersOsPtr().name() << endl;
     }
     Info<< "End\n" << endl;
     return 0;
