@@ -199,8 +199,10 @@ TEST_CASE("rigidLayers: bad input names the entry and the valid choices", "[foam
 {
     using Catch::Matchers::Contains;
     const std::string unknown =
-        errorOf("rigidLayers { patches (wall); innerDistance 0.1; outerDistance 0.2; }");
-    CHECK_THAT(unknown, Contains("patches") && Contains("wall") && Contains("walls"));
+        errorOf("rigidLayers { patches (walls sphere); innerDistance 0.1; outerDistance 0.2; }");
+    CHECK_THAT(unknown, Contains("patches") && Contains("sphere") && Contains("(walls)"));
+    // A group names its patches (wall patches are in the group 'wall')
+    CHECK(errorOf("rigidLayers { patches (wall); innerDistance 0.1; outerDistance 0.2; }") == "no error");
     CHECK(errorOf("rigidLayers { patches (walls); innerDistance 0.1; outerDistance 0.2; }", "RBF") == "no error");
     CHECK_THAT
     (

@@ -122,14 +122,21 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
             valid.append(pbm[patchi].name());
         }
     }
+    const HashTable<labelList>& groups = pbm.groupPatchIDs();
     labelHashSet ids;
     for (const wordRe& pattern : patterns)
     {
+        // Patches by name, and the patches of the groups it names
         bool found = false;
         forAll(pbm, patchi)
         {
             const polyPatch& pp = pbm[patchi];
-            if (!pp.coupled() && !isA<emptyPolyPatch>(pp) && pattern.match(pp.name()))
+            bool match = pattern.match(pp.name());
+            for (const word& group : pp.inGroups())
+            {
+                match = match || (groups.found(group) && pattern.match(group));
+            }
+            if (match && !pp.coupled() && !isA<emptyPolyPatch>(pp))
             {
                 ids.insert(patchi);
                 found = true;
@@ -140,7 +147,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
             FatalIOErrorInFunction(dict)
                 << "patches: " << pattern << " matches no patch that can carry"
                 << " rigid layers (coupled and empty patches cannot); valid patches: "
-                << flatOutput(valid) << exit(FatalIOError);
+                << flatOutput(valid) << ", and groups of them" << exit(FatalIOError);
         }
     }
     patchIDs_ = ids.sortedToc();
