@@ -5,9 +5,11 @@
     checkPoints.py equal A B TIME [--tol T]  the points of two cases agree within T x domain size
     checkPoints.py at CASE TIME X0 Y0 Z0 X1 Y1 Z1 [--tol T]
                                              the point initially at X0 Y0 Z0 is at X1 Y1 Z1
-    checkPoints.py rigid CASE TIME INNER [--2d] [--tol T]
+    checkPoints.py rigid CASE TIME INNER [--2d] [--tol T] [--slip-layers]
                                              the points within INNER of the hole's points moved
-                                             with the hole's rigid motion (fitted to the hole)
+                                             with the hole's rigid motion (fitted to the hole);
+                                             --slip-layers: and those within INNER of a sliding
+                                             box face (x, y) keep their distance from it
 
 Exit status 1 on any failed check; prints what it measured. Other test scripts
 import it for readPoints, readLabels, pointsAt and check (run from the project's
@@ -82,6 +84,18 @@ def main():
         far = dist > 2*inner
         farErr = np.abs(p1[far] - (p0[far] @ R.T + t)).max()
         check(farErr > 1e-3, "points further out do not (largest departure %.3g)" % farErr)
+        if "--slip-layers" in sys.argv:
+            # nearest box face, when it is an x or y face (and clearly nearest)
+            planes = np.stack([p0[:, 0], 1 - p0[:, 0], p0[:, 1], 1 - p0[:, 1]]
+                              + ([] if twoD else [p0[:, 2], 1 - p0[:, 2]]), axis=1)
+            near = planes.argmin(axis=1)
+            srt = np.sort(planes, axis=1)
+            slip = (srt[:, 0] < inner) & (near < 4) & (srt[:, 1] - srt[:, 0] > 1e-9) & (dist > inner)
+            axis = near[slip]//2
+            moved = np.abs(p1[slip, axis] - p0[slip, axis])
+            check(slip.sum() > 0 and moved.max() <= tol,
+                  "%d points within %g of a sliding face keep their distance from it: largest change %.2e"
+                  % (slip.sum(), inner, moved.max()))
         if twoD:
             zErr = np.abs(p1[:, 2] - p0[:, 2]).max()
             check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)

@@ -24,7 +24,8 @@ ap.add_argument("--move", type=float, default=0.06, help="x displacement of the 
 ap.add_argument("--rotate", type=float, default=None, metavar="DEG",
                 help="turn the hole rigidly about the z axis through (0.45 0.5 0.5) by DEG at the end time instead")
 ap.add_argument("--rigid-layers", type=float, nargs=2, default=None, metavar=("INNER", "OUTER"),
-                help="rigidLayers on the hole with these inner and outer distances")
+                help="rigidLayers with these inner and outer distances")
+ap.add_argument("--layer-patches", default="hole", help="rigidLayers' patches (default: hole)")
 a = ap.parse_args()
 
 X = [0.0, 0.35, 0.65, 1.0]
@@ -115,8 +116,8 @@ write("system/fvSolution", "dictionary", "fvSolution",
 write("system/decomposeParDict", "dictionary", "decomposeParDict",
       "numberOfSubdomains %d; method hierarchical; coeffs { n (%d 1 1); order xyz; }" % (a.np, a.np))
 
-layers = ("rigidLayers { patches (hole); innerDistance %.17g; outerDistance %.17g; }" % tuple(a.rigid_layers)
-          if a.rigid_layers else "")
+layers = ("rigidLayers { patches (%s); innerDistance %.17g; outerDistance %.17g; }"
+          % ((a.layer_patches,) + tuple(a.rigid_layers)) if a.rigid_layers else "")
 coeffs = {"multilevelBSpline": "multilevelBSplineCoeffs { tolerance 1e-10; %s }" % layers,
           "RBF": "RBFCoeffs { %s }" % layers,
           "displacementLaplacian": "displacementLaplacianCoeffs { diffusivity quadratic inverseDistance 1 (hole); }"}

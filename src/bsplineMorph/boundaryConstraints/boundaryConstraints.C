@@ -309,6 +309,32 @@ Foam::boundaryConstraints::boundaryConstraints
 }
 
 
+void Foam::boundaryConstraints::addPoints(const labelList& points)
+{
+    bitSet all(pMesh_().nPoints());
+    all.set(boundaryPoints_);
+    all.set(points);
+    if (label(all.count()) != boundaryPoints_.size())
+    {
+        boundaryPoints_ = all.sortedToc();
+    }
+}
+
+
+void Foam::boundaryConstraints::fix(const label pointi, const vector& value)
+{
+    fixedSync_[pointi] = 1;
+    fixed_[pointi] = true;
+    value_[pointi] = value;
+}
+
+
+void Foam::boundaryConstraints::slide(const label pointi, const pointConstraint& pc)
+{
+    slide_[pointi] = pc;
+}
+
+
 Foam::label Foam::boundaryConstraints::nControlGlobal() const
 {
     return returnReduce(controlPoints_.size(), sumOp<label>());

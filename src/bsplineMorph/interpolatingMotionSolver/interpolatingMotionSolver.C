@@ -224,18 +224,29 @@ void Foam::interpolatingMotionSolver::solve()
 
     // The control set, updated in place after the first step (its
     // mesh-sized arrays kept); whether its points or masks changed
-    bool changed = true;
-    if (constraintsPtr_)
-    {
-        const labelList points(constraintsPtr_->controlPoints());
-        const std::vector<std::uint8_t> mask(constraintsPtr_->mask());
-        constraintsPtr_->update(pointDisplacement_);
-        changed = !constraintsPtr_->sameControls(points, mask);
-    }
-    else
+    const bool first = !constraintsPtr_;
+    labelList points;
+    std::vector<std::uint8_t> mask;
+    if (first)
     {
         constraintsPtr_.reset(new boundaryConstraints(pointDisplacement_));
     }
+    else
+    {
+        points = constraintsPtr_->controlPoints();
+        mask = constraintsPtr_->mask();
+        constraintsPtr_->update(pointDisplacement_);
+    }
+    // The rigid layers' outermost points are control points too
+    if (rigidLayersPtr_)
+    {
+        if (first)
+        {
+            rigidLayersPtr_->checkConstrained(*constraintsPtr_);
+        }
+        rigidLayersPtr_->addControls(*constraintsPtr_, points0());
+    }
+    const bool changed = first || !constraintsPtr_->sameControls(points, mask);
 
     // The displacement is worked out in pointDisplacement's own values (the
     // conditions have been read), and the moved points beside it: every point
@@ -282,10 +293,6 @@ void Foam::interpolatingMotionSolver::solve()
         // final displacement: the boundary points constrained first)
         if (rigidLayersPtr_)
         {
-            if (changed)
-            {
-                rigidLayersPtr_->checkConstrained(*constraintsPtr_);
-            }
             constraintsPtr_->constrain(displacement);
             rigidLayersPtr_->apply
             (

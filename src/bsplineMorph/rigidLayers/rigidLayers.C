@@ -387,6 +387,44 @@ void Foam::rigidLayers::plan(const pointField& points0)
     zoneWeight_.transfer(weights);
     zoneArm_.transfer(arms);
 
+    // The rigid zone's outermost points off the patches (within
+    // innerDistance, with an edge to a point beyond it): the interpolation's
+    // extra control points
+    boolList inner(mesh_.nPoints(), false);
+    forAll(zonePoints_, i)
+    {
+        inner[zonePoints_[i]] = zoneWeight_[i] == 1;
+    }
+    labelList outermost(mesh_.nPoints(), 0);
+    for (const edge& e : mesh_.edges())
+    {
+        if (inner[e.first()] != inner[e.second()])
+        {
+            outermost[inner[e.first()] ? e.first() : e.second()] = 1;
+        }
+    }
+    syncTools::syncPointList(mesh_, outermost, maxEqOp<label>(), label(0));
+    bitSet onPatch(mesh_.nPoints());
+    for (const polyPatch& pp : pbm)
+    {
+        if (!pp.coupled() && !isA<emptyPolyPatch>(pp))
+        {
+            onPatch.set(pp.meshPoints());
+        }
+    }
+    DynamicList<label> shell, shellPoints;
+    forAll(zonePoints_, i)
+    {
+        const label pointi = zonePoints_[i];
+        if (inner[pointi] && outermost[pointi] && !onPatch.test(pointi))
+        {
+            shell.append(i);
+            shellPoints.append(pointi);
+        }
+    }
+    shell_.transfer(shell);
+    shellPoints_.transfer(shellPoints);
+
     // The feet in compact numbering: this rank's wall points, then the other
     // ranks' that are feet here
     List<Map<label>> compactMap;
@@ -400,20 +438,24 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << returnReduce(nWall, sumOp<label>()) << " wall points on patches "
         << flatOutput(patchNames)
         << " (" << returnReduce(nInner, sumOp<label>())
-        << " within innerDistance " << innerDistance_ << ")" << endl;
+        << " within innerDistance " << innerDistance_ << ", "
+        << returnReduce(shellPoints_.size(), sumOp<label>())
+        << " of them outermost: control points)" << endl;
 }
 
 
 void Foam::rigidLayers::fitRotations
 (
     const pointField& points0,
-    const vectorField& displacement
+    const vectorField& displacement,
+    const boolList* known
 )
 {
     // Per wall point: M = sum over its faces on the listed patches of
     // e1 e0^T over the face's edges and A1 A0^T/|A0| (A: area vector;
     // 0: points0, 1: moved); a rigid motion R gives M = R S, S symmetric
-    // positive definite, whose polar factor is R
+    // positive definite, whose polar factor is R. With known: only the
+    // faces all of whose points are known
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     const label nWall = wallPoints_.size();
     rotation_.setSize(nWall);
@@ -425,11 +467,15 @@ void Foam::rigidLayers::fitRotations
         forAll(pp, facei)
         {
             const face& f = pp[facei];
-            tensor M(Zero);
-            forAll(f, k)
+            if (known && !std::all_of(f.begin(), f.end(), [&](label p) { return (*known)[p]; }))
             {
-                const label a = f[k];
-                const label b = f.nextLabel(k);
+                continue;
+            }
+            tensor M(Zero);
+            forAll(f, edgei)
+            {
+                const label a = f[edgei];
+                const label b = f.nextLabel(edgei);
                 const vector e0 = points0[b] - points0[a];
                 const vector e1 = e0 + displacement[b] - displacement[a];
                 M += e1*e0;
@@ -479,6 +525,56 @@ void Foam::rigidLayers::checkConstrained(const boundaryConstraints& bc) const
             << " ...) or that slide (slip, symmetryPlane, ...)"
             << exit(FatalIOError);
     }
+}
+
+
+void Foam::rigidLayers::addControls
+(
+    boundaryConstraints& bc,
+    const pointField& points0
+)
+{
+    if (!planned_)
+    {
+        plan(points0);
+    }
+    bc.addPoints(shellPoints_);
+
+    // The feet's rigid motions from the prescribed wall displacements alone
+    // (the sliding ones are known only after the fit)
+    const boolList& fixed = bc.fixed();
+    const vectorField& prescribed = bc.prescribed();
+    fitRotations(points0, prescribed, &fixed);
+    footDisplacement_ = vectorField(prescribed, wallPoints_);
+    labelList footFixed(wallPoints_.size());
+    List<pointConstraint> footSlide(wallPoints_.size());
+    forAll(wallPoints_, i)
+    {
+        footFixed[i] = fixed[wallPoints_[i]];
+        footSlide[i] = bc.slides()[wallPoints_[i]];
+    }
+    mapPtr_->distribute(rotation_);
+    mapPtr_->distribute(footDisplacement_);
+    mapPtr_->distribute(footFixed);
+    mapPtr_->distribute(footSlide);
+
+    // The outermost points: fixed at their foot's rigid motion, or sliding
+    // as their foot does (at their distance from a sliding wall)
+    for (const label i : shell_)
+    {
+        const label pointi = zonePoints_[i];
+        const label j = zoneFoot_[i];
+        if (footFixed[j])
+        {
+            const vector& arm = zoneArm_[i];
+            bc.fix(pointi, footDisplacement_[j] + (rotation_[j] & arm) - arm);
+        }
+        else if (footSlide[j].first() > 0)
+        {
+            bc.slide(pointi, footSlide[j]);
+        }
+    }
+    bc.collectControls();
 }
 
 
