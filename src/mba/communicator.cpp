@@ -160,4 +160,10 @@ void runSimulated(int n, const std::function<void(const communicator&)>& body)
         }
 }
 
+const communicator& serial()
+{
+    static const serialCommunicator comm;
+    return comm;
+}
+
 } // namespace mba

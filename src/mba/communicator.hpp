@@ -122,6 +122,10 @@ public:
     int size() const override { return 1; }
 };
 
+/// The serial communicator (one for the process, never destroyed before its
+/// users: pass this rather than a temporary serialCommunicator)
+const communicator& serial();
+
 /// Run body on n simulated ranks (threads of this process), each with its own
 /// communicator. Exceptions are rethrown after all ranks finished (the lowest
 /// rank's first); a rank that dies makes the others' next collective throw

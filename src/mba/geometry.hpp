@@ -33,6 +33,8 @@ template <int D> struct pointsView
     pointsView() = default;
     pointsView(const double* d, std::size_t n) : data(d), size(n) {}
     pointsView(const std::vector<point<D>>& p) : data(p.empty() ? nullptr : p[0].data()), size(p.size()) {}
+    /// A view of a temporary would dangle: not allowed
+    pointsView(const std::vector<point<D>>&&) = delete;
 
     const double* operator[](std::size_t i) const { return data + D*i; }
 };

@@ -7,6 +7,9 @@
 
 namespace mba {
 
+// The definition C++14 needs where the key is bound to a reference
+constexpr std::uint64_t hashMap::emptyKey;
+
 void params::validate() const
 {
     precondition(std::isfinite(tolerance) && tolerance >= 0,

@@ -173,6 +173,9 @@ public:
     multilevel(const communicator& comm, const params& p, int nComponents,
                pointsView<D> control, std::vector<std::uint8_t> mask,
                pointsView<D> evaluation, const box<D>* bounds = nullptr);
+    /// The plan keeps the communicator: a temporary one would dangle
+    multilevel(const communicator&&, const params&, int, pointsView<D>, std::vector<std::uint8_t>,
+               pointsView<D>, const box<D>* = nullptr) = delete;
     ~multilevel();
 
     /// Fit the control values (point x component; unconstrained components are

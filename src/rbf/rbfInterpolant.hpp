@@ -94,6 +94,8 @@ public:
     /// Collective: gathers the control points of all ranks and factors the
     /// system (with greedy selection: for the values given first, see fit)
     interpolant(const mba::communicator& comm, const params& p, int nComponents, pointsView<D> control);
+    /// The interpolant keeps the communicator: a temporary one would dangle
+    interpolant(const mba::communicator&&, const params&, int, pointsView<D>) = delete;
 
     /// Collective: coefficients for this rank's control values (point x component).
     /// With greedy selection the centres are chosen at the first fit and kept.

@@ -11,7 +11,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const serialCommunicator serial;
 
 template <int D>
 void singlePointReproduced(bool affine)
@@ -22,7 +21,7 @@ void singlePointReproduced(bool affine)
     p.affine = affine;
     p.maxLevels = 1;
     p.tolerance = 0;
-    multilevel<D> m(serial, p, 3, c, {}, e);
+    multilevel<D> m(serial(), p, 3, c, {}, e);
     const std::vector<double> v{0.7, -1.3, 2.9};
     m.fit(v);
     std::vector<double> out;
@@ -46,7 +45,7 @@ void affineReproduced()
     for (const auto& x : c) for (int k = 0; k < 3; ++k) v.push_back(g(x, k));
     params p;
     p.tolerance = 1e-12;
-    multilevel<D> m(serial, p, 3, c, {}, e);
+    multilevel<D> m(serial(), p, 3, c, {}, e);
     const fitReport& r = m.fit(v);
     CHECK(r.levels == 0);
     std::vector<double> out;
@@ -65,7 +64,7 @@ void residualDecreases(bool affine)
     p.tolerance = 1e-10;
     p.maxLevels = 20;
     p.affine = affine;
-    multilevel<D> m(serial, p, 2, c, {}, e);
+    multilevel<D> m(serial(), p, 2, c, {}, e);
     const fitReport& r = m.fit(v);
     CHECK(r.converged);
     CHECK(r.maxResidual <= 1e-10*maxAbs(v));
@@ -114,7 +113,7 @@ TEST_CASE("sparse storage grows with the surface, not the volume", "[core]")
     params p;
     p.tolerance = 1e-14;
     p.maxLevels = 9;
-    multilevel<3> m(serial, p, 1, c, {}, e);
+    multilevel<3> m(serial(), p, 1, c, {}, e);
     m.fit(smoothValues<3>(c, 1));
     const auto st = m.stats();
     REQUIRE(st.size() >= 6);
@@ -158,7 +157,7 @@ void flatEqualsLevels(int nc)
         for (int k = 0; k < nc; ++k) v.push_back(v3[3*i + k] + (k == 0 ? std::exp(-200*std::pow(c[i][1] - 0.4, 2)) : 0.0));
     params p;
     p.tolerance = 1e-10;
-    multilevel<D> m(serial, p, nc, c, {}, e);
+    multilevel<D> m(serial(), p, nc, c, {}, e);
     const fitReport& r = m.fit(v);
     REQUIRE(r.levels >= 6);
     std::vector<double> planned;
@@ -206,7 +205,7 @@ std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std
     p.affine = false;
     p.tolerance = 1e-13;
     p.maxLevels = 14;
-    multilevel<D> m(serial, p, 3, c, mask, e);
+    multilevel<D> m(serial(), p, 3, c, mask, e);
     std::vector<double> v1 = smoothValues<D>(c, 3), v2 = v1;
     for (double& x : v2) x = 0.4*x*x - x;
     m.fit(v1);
@@ -277,7 +276,7 @@ TEST_CASE("applying new values through the plan equals a fresh fit", "[core]")
     for (std::size_t i = 0; i < c.size(); i += 3) mask[2*i + 1] = 0;
     params p;
     p.tolerance = 1e-9;
-    multilevel<3> plan(serial, p, 2, c, mask, e);
+    multilevel<3> plan(serial(), p, 2, c, mask, e);
     std::vector<double> v1 = smoothValues<3>(c, 2), v2 = v1;
     for (auto& x : v2) x = 0.3*x*x - x;
     std::vector<double> a, b;
@@ -285,7 +284,7 @@ TEST_CASE("applying new values through the plan equals a fresh fit", "[core]")
     plan.evaluate(a);   // evaluating twice through the plan leaves nothing behind
     plan.fit(v2);
     plan.evaluate(a);
-    multilevel<3> fresh(serial, p, 2, c, mask, e);
+    multilevel<3> fresh(serial(), p, 2, c, mask, e);
     fresh.fit(v2);
     fresh.evaluate(b);
     REQUIRE(a.size() == b.size());
@@ -307,7 +306,7 @@ TEST_CASE("masked components constrain only what they mask", "[core]")
     params p;
     p.tolerance = 1e-12;
     p.maxLevels = 14;
-    multilevel<3> m(serial, p, 2, c, mask, std::vector<point<3>>{});
+    multilevel<3> m(serial(), p, 2, c, mask, pointsView<3>());
     const fitReport& r = m.fit(v);
     CHECK(r.converged);
     std::vector<double> out;
@@ -332,45 +331,45 @@ TEST_CASE("bad input gets a clear error", "[core][errors]")
     SECTION("non-finite control coordinate")
     {
         c[3][1] = std::numeric_limits<double>::quiet_NaN();
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 1, c, {}, e)), Contains("control point 3") && Contains("non-finite"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 1, c, {}, e)), Contains("control point 3") && Contains("non-finite"));
     }
     SECTION("non-finite evaluation coordinate")
     {
         e[7][0] = std::numeric_limits<double>::infinity();
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 1, c, {}, e)), Contains("evaluation point 7"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 1, c, {}, e)), Contains("evaluation point 7"));
     }
     SECTION("non-finite value")
     {
-        multilevel<3> m(serial, p, 1, c, {}, e);
+        multilevel<3> m(serial(), p, 1, c, {}, e);
         std::vector<double> v(20, 1.0);
         v[5] = std::numeric_limits<double>::quiet_NaN();
         REQUIRE_THROWS_WITH(m.fit(v), Contains("control value 5") && Contains("not finite"));
     }
     SECTION("mismatched sizes")
     {
-        multilevel<3> m(serial, p, 2, c, {}, e);
+        multilevel<3> m(serial(), p, 2, c, {}, e);
         REQUIRE_THROWS_WITH(m.fit(std::vector<double>(20, 1.0)), Contains("20 control values, expected 40"));
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 2, c, std::vector<std::uint8_t>(3, 1), e)), Contains("mask"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 2, c, std::vector<std::uint8_t>(3, 1), e)), Contains("mask"));
     }
     SECTION("zero or negative parameters")
     {
         params q;
         q.maxLevels = 0;
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("maxLevels"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), q, 1, c, {}, e)), Contains("maxLevels"));
         q = params();
         q.tolerance = -1;
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("tolerance"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), q, 1, c, {}, e)), Contains("tolerance"));
         q = params();
         q.initialGrid = 0;
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("initialGrid"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), q, 1, c, {}, e)), Contains("initialGrid"));
         q = params();
         q.padding = 0;
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, q, 1, c, {}, e)), Contains("padding"));
-        REQUIRE_THROWS_WITH((multilevel<3>(serial, p, 0, c, {}, e)), Contains("components"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), q, 1, c, {}, e)), Contains("padding"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 0, c, {}, e)), Contains("components"));
     }
     SECTION("evaluation outside the domain")
     {
-        multilevel<3> m(serial, p, 1, c, {}, e);
+        multilevel<3> m(serial(), p, 1, c, {}, e);
         m.fit(std::vector<double>(20, 1.0));
         const double x[3] = {5, 0.5, 0.5};
         double out[1];
@@ -385,7 +384,7 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
     p.maxLevels = 8;
     SECTION("no control points: zero everywhere")
     {
-        multilevel<3> m(serial, p, 3, std::vector<point<3>>{}, {}, e);
+        multilevel<3> m(serial(), p, 3, pointsView<3>(), {}, e);
         const fitReport& r = m.fit({});
         CHECK(r.levels == 0);
         std::vector<double> out;
@@ -399,7 +398,7 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
         auto c = randomPoints<3>(300, 62);
         for (auto& x : c) x[2] = 0.5;
         const auto v = smoothValues<3>(c, 1);
-        multilevel<3> m(serial, p, 1, c, {}, c);   // evaluated on the plane itself
+        multilevel<3> m(serial(), p, 1, c, {}, c);   // evaluated on the plane itself
         const fitReport& r = m.fit(v);
         CHECK(std::isfinite(r.maxResidual));
         std::vector<double> out;
@@ -411,7 +410,7 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
         std::vector<point<3>> c;
         std::vector<double> v;
         for (int i = 0; i < 50; ++i) { c.push_back({{i/49.0, 0.2, 0.3}}); v.push_back(1 + 2*(i/49.0)); }
-        multilevel<3> m(serial, p, 1, c, {}, c);
+        multilevel<3> m(serial(), p, 1, c, {}, c);
         const fitReport& r = m.fit(v);
         CHECK(r.levels == 0);    // a linear field along the line is affine
         std::vector<double> out;
@@ -425,7 +424,7 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
         c.push_back(c[0]);
         v[0] = 1.0;
         v.push_back(3.0);
-        multilevel<3> m(serial, p, 1, c, {}, e);
+        multilevel<3> m(serial(), p, 1, c, {}, e);
         const fitReport& r = m.fit(v);
         CHECK(r.levels == p.maxLevels);
         CHECK_FALSE(r.converged);
@@ -439,7 +438,7 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
     SECTION("a single control point")
     {
         const std::vector<point<3>> c{{{0.5, 0.5, 0.5}}};
-        multilevel<3> m(serial, p, 1, c, {}, std::vector<point<3>>{});
+        multilevel<3> m(serial(), p, 1, c, {}, pointsView<3>());
         m.fit({4.0});
         double out[1];
         m.evaluate(c[0].data(), out);

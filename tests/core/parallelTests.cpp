@@ -95,7 +95,7 @@ void serialEqualsRanks(bool affine, bool masked, partition how)
 
 TEST_CASE("communicator conformance: serial", "[parallel][conformance]")
 {
-    communicatorConformance(serialCommunicator());
+    communicatorConformance(serial());
 }
 
 TEST_CASE("communicator conformance: simulated ranks", "[parallel][conformance]")
@@ -130,7 +130,7 @@ TEST_CASE("levels that separate the control points: serial equals simulated rank
     const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
     {
         // (the finest level used does separate them)
-        multilevel<3> m(serialCommunicator(), pb.p, pb.nc, c, mask, e);
+        multilevel<3> m(serial(), pb.p, pb.nc, c, mask, e);
         std::vector<double> vm = v;
         const fitReport& r = m.fit(vm);
         REQUIRE(r.converged);
@@ -166,7 +166,7 @@ TEST_CASE("ranks without control or evaluation points", "[parallel]")
     p.tolerance = faces ? 1e-12 : 1e-10;
     std::vector<double> ref;
     {
-        multilevel<3> m(serialCommunicator(), p, 1, c, {}, e);
+        multilevel<3> m(serial(), p, 1, c, {}, e);
         const fitReport& r = m.fit(v);
         m.evaluate(ref);
         if (faces) REQUIRE(m.stats()[r.levels - 1].separated);
@@ -226,7 +226,7 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
     std::int64_t serialNodes = 0;
     int levels = 0;
     {
-        multilevel<3> m(serialCommunicator(), p, 1, c, {}, e);
+        multilevel<3> m(serial(), p, 1, c, {}, e);
         levels = m.fit(v).levels;
         serialNodes = m.stats()[levels - 1].nodes;
     }

@@ -10,7 +10,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const mba::serialCommunicator serial;
 
 template <int D>
 void reproducesControlValues(rbf::kernel k)
@@ -19,7 +18,7 @@ void reproducesControlValues(rbf::kernel k)
     const auto v = smoothValues<D>(c, 3);
     rbf::params p;
     p.function = k;
-    rbf::interpolant<D> s(serial, p, 3, c);
+    rbf::interpolant<D> s(mba::serial(), p, 3, c);
     s.fit(v);
     std::vector<double> out;
     s.evaluate(c, out);
@@ -49,7 +48,7 @@ TEST_CASE("RBF with the polynomial reproduces affine motion everywhere", "[rbf]"
     {
         rbf::params p;
         p.function = kern;
-        rbf::interpolant<3> s(serial, p, 3, c);
+        rbf::interpolant<3> s(mba::serial(), p, 3, c);
         s.fit(v);
         std::vector<double> out;
         s.evaluate(e, out);
@@ -67,7 +66,7 @@ TEST_CASE("RBF: serial equals 2 and 3 ranks", "[rbf][parallel]")
     rbf::params p;
     std::vector<double> ref;
     {
-        rbf::interpolant<3> s(serial, p, 2, c);
+        rbf::interpolant<3> s(mba::serial(), p, 2, c);
         s.fit(v);
         s.evaluate(e, ref);
     }
@@ -101,7 +100,7 @@ TEST_CASE("RBF greedy selection meets its tolerance with fewer centres", "[rbf]"
     rbf::params p;
     p.greedyTolerance = 1e-3;
     p.greedyBatch = 40;
-    rbf::interpolant<3> s(serial, p, 1, c);
+    rbf::interpolant<3> s(mba::serial(), p, 1, c);
     s.fit(v);
     CHECK(s.stats().centres < s.stats().controlPoints);
     CHECK(s.stats().maxError <= 1e-3);
@@ -116,27 +115,27 @@ TEST_CASE("RBF rejects bad parameters and systems with a clear message", "[rbf][
     const auto c = randomPoints<3>(100, 231);
     rbf::params p;
     SECTION("unknown function") { REQUIRE_THROWS_WITH(rbf::kernelFromName("gaussian"), Contains("inverseMultiquadric thinPlateSpline wendlandC2")); }
-    SECTION("shape parameter") { p.shapeParameter = 0; REQUIRE_THROWS_WITH((rbf::interpolant<3>(serial, p, 1, c)), Contains("shapeParameter")); }
+    SECTION("shape parameter") { p.shapeParameter = 0; REQUIRE_THROWS_WITH((rbf::interpolant<3>(mba::serial(), p, 1, c)), Contains("shapeParameter")); }
     SECTION("thin-plate spline without polynomial")
     {
         p.function = rbf::kernel::thinPlateSpline;
         p.polynomial = false;
-        REQUIRE_THROWS_WITH((rbf::interpolant<3>(serial, p, 1, c)), Contains("polynomial"));
+        REQUIRE_THROWS_WITH((rbf::interpolant<3>(mba::serial(), p, 1, c)), Contains("polynomial"));
     }
     SECTION("too large")
     {
         p.maxPoints = 50;
-        REQUIRE_THROWS_WITH((rbf::interpolant<3>(serial, p, 1, c)), Contains("100 control points exceed maxPoints 50") && Contains("MB"));
+        REQUIRE_THROWS_WITH((rbf::interpolant<3>(mba::serial(), p, 1, c)), Contains("100 control points exceed maxPoints 50") && Contains("MB"));
     }
     SECTION("ill-conditioned")
     {
         // a nearly flat basis: the classic ill-conditioned RBF system
         p.shapeParameter = 1e3;
-        REQUIRE_THROWS_WITH((rbf::interpolant<3>(serial, p, 1, c)), Contains("ill-conditioned") && Contains("shapeParameter"));
+        REQUIRE_THROWS_WITH((rbf::interpolant<3>(mba::serial(), p, 1, c)), Contains("ill-conditioned") && Contains("shapeParameter"));
     }
     SECTION("non-finite value")
     {
-        rbf::interpolant<3> s(serial, p, 1, c);
+        rbf::interpolant<3> s(mba::serial(), p, 1, c);
         std::vector<double> v(100, 0.0);
         v[4] = std::nan("");
         REQUIRE_THROWS_WITH(s.fit(v), Contains("control value 4"));
