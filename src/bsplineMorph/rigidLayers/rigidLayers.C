@@ -75,18 +75,11 @@ namespace
         return s;
     }
 
-    //- A candidate foot: a wall point of this or another rank
-    struct footCandidate
-    {
-        label globalIndex;
-        point x;
-        bool local;
-    };
-
     //- Whether foot a is preferred to foot b at the same squared distance:
     //  the lexicographically smaller point, then a copy on this rank (the
     //  same point on two ranks has the same transform)
-    bool preferred(const footCandidate& a, const footCandidate& b)
+    template<class Candidate>
+    bool preferred(const Candidate& a, const Candidate& b)
     {
         for (direction d = 0; d < 3; ++d)
         {
@@ -109,7 +102,8 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     dict_(dict),
     innerDistance_(0),
     outerDistance_(0),
-    planned_(false)
+    planned_(false),
+    transformsFinal_(false)
 {
     // Patches: every pattern must match a patch that can carry layers
     const wordRes patterns(dict.get<wordRes>("patches"));
@@ -239,11 +233,9 @@ Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
 }
 
 
-void Foam::rigidLayers::plan(const pointField& points0)
+void Foam::rigidLayers::findWallPoints()
 {
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
-    const label myProc = Pstream::myProcNo();
-
     // The wall points, and where each listed patch's points are among them
     bitSet onWall(mesh_.nPoints());
     for (const label patchi : patchIDs_)
@@ -251,8 +243,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
         onWall.set(pbm[patchi].meshPoints());
     }
     wallPoints_ = onWall.sortedToc();
-    const label nWall = wallPoints_.size();
-    Map<label> wallOf(2*nWall);
+    Map<label> wallOf(2*wallPoints_.size());
     forAll(wallPoints_, i)
     {
         wallOf.insert(wallPoints_[i], i);
@@ -267,8 +258,16 @@ void Foam::rigidLayers::plan(const pointField& points0)
             patchWall_[k][i] = wallOf[meshPoints[i]];
         }
     }
-    const globalIndex wallIndex(nWall);
+}
 
+
+std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
+(
+    const pointField& points0,
+    const globalIndex& wallIndex
+) const
+{
+    const label myProc = Pstream::myProcNo();
     // Candidate feet: this rank's wall points and those of the other ranks
     // within outerDistance of this rank's points
     const scalar outer = outerDistance_;
@@ -278,7 +277,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
     Pstream::scatterList(rankBox);
 
     std::vector<footCandidate> cand;
-    cand.reserve(nWall);
+    cand.reserve(wallPoints_.size());
     forAll(wallPoints_, i)
     {
         cand.push_back({wallIndex.toGlobal(i), points0[wallPoints_[i]], true});
@@ -324,10 +323,22 @@ void Foam::rigidLayers::plan(const pointField& points0)
         }
     }
 
+    return cand;
+}
+
+
+void Foam::rigidLayers::findFeet
+(
+    const pointField& points0,
+    const std::vector<footCandidate>& cand
+)
+{
+    const scalar outer = outerDistance_;
+    const boundBox bounds(points0, false);
     // Bins of size outerDistance: every candidate within outerDistance of a
     // point lies in the point's bin or one of its 26 neighbours
     const scalar h = outer;
-    const point origin = rankBox[myProc].empty() ? point::zero : rankBox[myProc].min();
+    const point origin = bounds.empty() ? point::zero : bounds.min();
     auto binOf = [&](const point& x, const int o0, const int o1, const int o2)
     {
         const std::int64_t i = std::int64_t(std::floor((x.x() - origin.x())/h)) + o0;
@@ -336,9 +347,11 @@ void Foam::rigidLayers::plan(const pointField& points0)
         return std::uint64_t(((i & 0x1fffff) << 42) | ((j & 0x1fffff) << 21) | (k & 0x1fffff));
     };
     std::unordered_map<std::uint64_t, std::vector<label>> bins;
+    boundBox candBox;
     for (std::size_t c = 0; c < cand.size(); ++c)
     {
         bins[binOf(cand[c].x, 0, 0, 0)].push_back(label(c));
+        candBox.add(cand[c].x);
     }
 
     // Each point's foot: the nearest candidate (ties: preferred())
@@ -349,6 +362,10 @@ void Foam::rigidLayers::plan(const pointField& points0)
     forAll(points0, pointi)
     {
         const point& x = points0[pointi];
+        if (distSqrToBox(x, candBox) > outerSqr)
+        {
+            continue;   // (most points of a large mesh: no bin look-ups)
+        }
         label best = -1;
         scalar bestSqr = outerSqr;
         for (int o0 = -1; o0 <= 1; ++o0)
@@ -387,6 +404,11 @@ void Foam::rigidLayers::plan(const pointField& points0)
     zoneWeight_.transfer(weights);
     zoneArm_.transfer(arms);
 
+}
+
+
+void Foam::rigidLayers::findOutermost()
+{
     // The rigid zone's outermost points off the patches (within
     // innerDistance, with an edge to a point beyond it): the interpolation's
     // extra control points
@@ -405,7 +427,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
     }
     syncTools::syncPointList(mesh_, outermost, maxEqOp<label>(), label(0));
     bitSet onPatch(mesh_.nPoints());
-    for (const polyPatch& pp : pbm)
+    for (const polyPatch& pp : mesh_.boundaryMesh())
     {
         if (!pp.coupled() && !isA<emptyPolyPatch>(pp))
         {
@@ -425,17 +447,27 @@ void Foam::rigidLayers::plan(const pointField& points0)
     shell_.transfer(shell);
     shellPoints_.transfer(shellPoints);
 
+}
+
+
+void Foam::rigidLayers::plan(const pointField& points0)
+{
+    findWallPoints();
+    const globalIndex wallIndex(wallPoints_.size());
+    findFeet(points0, footCandidates(points0, wallIndex));
+    findOutermost();
     // The feet in compact numbering: this rank's wall points, then the other
     // ranks' that are feet here
     List<Map<label>> compactMap;
     mapPtr_.reset(new mapDistribute(wallIndex, zoneFoot_, compactMap));
     planned_ = true;
 
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     const wordList patchNames(pbm.names(), patchIDs_);
     const label nInner = std::count(zoneWeight_.begin(), zoneWeight_.end(), scalar(1));
     Info<< "rigidLayers: " << returnReduce(zonePoints_.size(), sumOp<label>())
         << " points within outerDistance " << outerDistance_ << " of "
-        << returnReduce(nWall, sumOp<label>()) << " wall points on patches "
+        << returnReduce(wallPoints_.size(), sumOp<label>()) << " wall points on patches "
         << flatOutput(patchNames)
         << " (" << returnReduce(nInner, sumOp<label>())
         << " within innerDistance " << innerDistance_ << ", "
@@ -545,6 +577,15 @@ void Foam::rigidLayers::addControls
     const boolList& fixed = bc.fixed();
     const vectorField& prescribed = bc.prescribed();
     fitRotations(points0, prescribed, &fixed);
+    // Walls all of whose points are prescribed (in 3D: in 2D the empty
+    // direction of a prescribed value is zeroed later) have these transforms
+    // after the fit too: apply() keeps them
+    bool allFixed = mesh_.nSolutionD() == 3;
+    for (const label pointi : wallPoints_)
+    {
+        allFixed = allFixed && fixed[pointi];
+    }
+    transformsFinal_ = returnReduce(allFixed, andOp<bool>());
     footDisplacement_ = vectorField(prescribed, wallPoints_);
     labelList footFixed(wallPoints_.size());
     List<pointConstraint> footSlide(wallPoints_.size());
@@ -591,10 +632,13 @@ void Foam::rigidLayers::apply
     {
         plan(points0);
     }
-    fitRotations(points0, displacement);
-    footDisplacement_ = vectorField(displacement, wallPoints_);
-    mapPtr_->distribute(rotation_);
-    mapPtr_->distribute(footDisplacement_);
+    if (!transformsFinal_)
+    {
+        fitRotations(points0, displacement);
+        footDisplacement_ = vectorField(displacement, wallPoints_);
+        mapPtr_->distribute(rotation_);
+        mapPtr_->distribute(footDisplacement_);
+    }
 
     bool solved[3] = {false, false, false};
     for (const label d : dirs)
