@@ -24,11 +24,12 @@ License
 #include "PstreamBuffers.H"
 #include "HashOps.H"
 #include "wordRes.H"
+#include "indexedOctree.H"
+#include "treeDataPoint.H"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
@@ -333,77 +334,67 @@ void Foam::rigidLayers::findFeet
     const std::vector<footCandidate>& cand
 )
 {
-    const scalar outer = outerDistance_;
-    const boundBox bounds(points0, false);
-    // Bins of size outerDistance: every candidate within outerDistance of a
-    // point lies in the point's bin or one of its 26 neighbours
-    const scalar h = outer;
-    const point origin = bounds.empty() ? point::zero : bounds.min();
-    auto binOf = [&](const point& x, const int o0, const int o1, const int o2)
+    // The candidates in an octree: each point's nearest one within
+    // outerDistance, then every candidate at exactly that distance (ties go
+    // to preferred())
+    zonePoints_.clear();
+    zoneFoot_.clear();
+    zoneWeight_.clear();
+    zoneArm_.clear();
+    if (cand.empty())
     {
-        const std::int64_t i = std::int64_t(std::floor((x.x() - origin.x())/h)) + o0;
-        const std::int64_t j = std::int64_t(std::floor((x.y() - origin.y())/h)) + o1;
-        const std::int64_t k = std::int64_t(std::floor((x.z() - origin.z())/h)) + o2;
-        return std::uint64_t(((i & 0x1fffff) << 42) | ((j & 0x1fffff) << 21) | (k & 0x1fffff));
-    };
-    std::unordered_map<std::uint64_t, std::vector<label>> bins;
-    boundBox candBox;
-    for (std::size_t c = 0; c < cand.size(); ++c)
-    {
-        bins[binOf(cand[c].x, 0, 0, 0)].push_back(label(c));
-        candBox.add(cand[c].x);
+        return;
     }
+    pointField candPoints(label(cand.size()));
+    forAll(candPoints, c)
+    {
+        candPoints[c] = cand[c].x;
+    }
+    const treeBoundBox candBox(candPoints);
+    const treeDataPoint shapes(candPoints);
+    const indexedOctree<treeDataPoint> tree
+    (
+        shapes,
+        treeBoundBox(candBox.min() - vector::one*outerDistance_, candBox.max() + vector::one*outerDistance_),
+        10,     // levels
+        10,     // candidates per leaf
+        3       // duplicity
+    );
 
-    // Each point's foot: the nearest candidate (ties: preferred())
     DynamicList<label> zone, feet;
     DynamicList<scalar> weights;
     DynamicList<vector> arms;
-    const scalar outerSqr = outer*outer;
+    const scalar outerSqr = sqr(outerDistance_);
     forAll(points0, pointi)
     {
         const point& x = points0[pointi];
-        if (distSqrToBox(x, candBox) > outerSqr)
+        if (distSqrToBox(x, candBox) >= outerSqr)
         {
-            continue;   // (most points of a large mesh: no bin look-ups)
+            continue;   // (most points of a large mesh: no search)
         }
-        label best = -1;
-        scalar bestSqr = outerSqr;
-        for (int o0 = -1; o0 <= 1; ++o0)
-        for (int o1 = -1; o1 <= 1; ++o1)
-        for (int o2 = -1; o2 <= 1; ++o2)
+        const pointIndexHit hit = tree.findNearest(x, outerSqr);
+        if (!hit.hit())
         {
-            const auto bin = bins.find(binOf(x, o0, o1, o2));
-            if (bin == bins.end())
+            continue;
+        }
+        label best = hit.index();
+        const scalar bestSqr = magSqr(x - cand[best].x);
+        for (const label c : tree.findSphere(x, bestSqr))
+        {
+            if (magSqr(x - cand[c].x) == bestSqr && preferred(cand[c], cand[best]))
             {
-                continue;
-            }
-            for (const label c : bin->second)
-            {
-                const scalar s = magSqr(x - cand[c].x);
-                if
-                (
-                    s < bestSqr
-                 || (s == bestSqr && best >= 0 && preferred(cand[c], cand[best]))
-                )
-                {
-                    best = c;
-                    bestSqr = s;
-                }
+                best = c;
             }
         }
-        if (best >= 0)
-        {
-            zone.append(pointi);
-            feet.append(cand[best].globalIndex);
-            weights.append(weight(std::sqrt(bestSqr), innerDistance_, outer));
-            arms.append(x - cand[best].x);
-        }
+        zone.append(pointi);
+        feet.append(cand[best].globalIndex);
+        weights.append(weight(std::sqrt(bestSqr), innerDistance_, outerDistance_));
+        arms.append(x - cand[best].x);
     }
     zonePoints_.transfer(zone);
     zoneFoot_.transfer(feet);
     zoneWeight_.transfer(weights);
     zoneArm_.transfer(arms);
-
 }
 
 
