@@ -104,6 +104,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     innerDistance_(0),
     outerDistance_(0),
     planned_(false),
+    nSmooth_(0),
     transformsFinal_(false)
 {
     // Patches: every pattern must match a patch that can carry layers
@@ -249,6 +250,23 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallOf.insert(wallPoints_[i], i);
     }
+    // The smoothing of the rotations: as many rings of faces as make
+    // innerDistance (by the walls' mean edge length)
+    scalar edgeSum = 0;
+    label nEdges = 0;
+    for (const label patchi : patchIDs_)
+    {
+        for (const edge& e : pbm[patchi].edges())
+        {
+            edgeSum += e.mag(pbm[patchi].localPoints());
+            ++nEdges;
+        }
+    }
+    edgeSum = returnReduce(edgeSum, sumOp<scalar>());
+    nEdges = returnReduce(nEdges, sumOp<label>());
+    nSmooth_ = nEdges && edgeSum > 0
+      ? min(label(std::ceil(innerDistance_*nEdges/edgeSum)), label(50)) : 0;
+
     patchWall_.setSize(patchIDs_.size());
     forAll(patchIDs_, k)
     {
@@ -463,7 +481,8 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << " (" << returnReduce(nInner, sumOp<label>())
         << " within innerDistance " << innerDistance_ << ", "
         << returnReduce(shellPoints_.size(), sumOp<label>())
-        << " of them outermost: control points)" << endl;
+        << " of them outermost: control points; rotations smoothed over "
+        << nSmooth_ << " rings of faces)" << endl;
 }
 
 
@@ -514,6 +533,31 @@ void Foam::rigidLayers::fitRotations
     }
     // The sums of the ranks that share a point, the same on all of them
     syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
+    // Summed over the neighbouring faces again, nSmooth_ times (a ring of
+    // faces each): the rotations vary smoothly over about innerDistance of a
+    // deforming wall, so that the rigid offsets under a crease do not cross;
+    // a rigid motion still gives R times a sum of S, whose polar factor is R
+    for (label sweep = 0; sweep < nSmooth_; ++sweep)
+    {
+        tensorField next(nWall, Zero);
+        forAll(patchIDs_, k)
+        {
+            for (const face& f : pbm[patchIDs_[k]].localFaces())
+            {
+                tensor sum(Zero);
+                for (const label lp : f)
+                {
+                    sum += rotation_[patchWall_[k][lp]];
+                }
+                for (const label lp : f)
+                {
+                    next[patchWall_[k][lp]] += sum;
+                }
+            }
+        }
+        syncTools::syncPointList(mesh_, wallPoints_, next, plusEqOp<tensor>(), tensor::zero);
+        rotation_.transfer(next);
+    }
     for (tensor& R : rotation_)
     {
         R = rotation(R);
