@@ -16,7 +16,9 @@
 #include "IOdictionary.H"
 #include "fvMesh.H"
 #include "volFields.H"
+#include "primitiveMeshTools.H"
 
+#include <algorithm>
 #include <limits>
 
 using namespace Foam;
@@ -96,33 +98,119 @@ TEST_CASE("multilevelBSpline: the defaults give a working solver", "[foam][bspli
 }
 
 
-TEST_CASE("The inverted-cell check's volumes: exact for planar faces, negative in mirrored cells", "[foam][bsplineMorph]")
+namespace
 {
-    // The box folded about its mid-plane x = 1/2 (a plane of mesh points),
-    // then sheared and stretched: every face stays planar, the cells below
-    // the plane are mirrored (volume -det(A) V), the others not (det(A) V)
+    // checkMesh's own verdict on the mesh's cells with these points: a copy
+    // of the mesh moved to them (its cell centres and volumes), its cell
+    // volumes below VSMALL and the face pyramids against its centres below
+    // -SMALL that checkCellVolumes and checkFacePyramids report (each
+    // pyramid on its own side); the number of cells with either (all ranks)
+    label checkMeshInvalidCells(const polyMesh& mesh, const pointField& p)
+    {
+        polyMesh copy
+        (
+            IOobject("checkMeshCopy", mesh.time().constant(), mesh.time(),
+                IOobject::NO_READ, IOobject::NO_WRITE, false),
+            pointField(p),
+            faceList(mesh.faces()),
+            labelList(mesh.faceOwner()),
+            labelList(mesh.faceNeighbour()),
+            false
+        );
+        boolList invalid(mesh.nCells(), false);
+        forAll(copy.cellVolumes(), celli)
+        {
+            invalid[celli] = copy.cellVolumes()[celli] < VSMALL;
+        }
+        scalarField ownPyrVol, neiPyrVol;
+        primitiveMeshTools::facePyramidVolume(copy, p, copy.cellCentres(), ownPyrVol, neiPyrVol);
+        forAll(ownPyrVol, facei)
+        {
+            if (ownPyrVol[facei] < -SMALL) invalid[mesh.faceOwner()[facei]] = true;
+        }
+        forAll(neiPyrVol, facei)
+        {
+            if (neiPyrVol[facei] < -SMALL) invalid[mesh.faceNeighbour()[facei]] = true;
+        }
+        return returnReduce(label(std::count(invalid.begin(), invalid.end(), true)), sumOp<label>());
+    }
+}
+
+
+TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "[foam][bsplineMorph]")
+{
     const fvMesh& mesh = bsmTest::mesh();
     const pointField& p0 = mesh.points();
-    const tensor A(1.2, 0.3, 0, 0, 0.9, 0.2, 0.1, 0, 1.1);
-    pointField p(p0.size());
-    forAll(p0, pointi)
-    {
-        vector x = p0[pointi];
-        x.x() = mag(x.x() - 0.5);
-        p[pointi] = (A & x) + vector(0.3, -0.2, 0.1);
-    }
-    scalarField vol;
-    interpolatingMotionSolver::signedCellVolumes(mesh, p, vol);
-    REQUIRE(vol.size() == mesh.nCells());
-    label nMirrored = 0;
-    forAll(vol, celli)
-    {
-        const scalar sign = mesh.C()[celli].x() < 0.5 ? -1 : 1;
-        nMirrored += (sign < 0);
-        REQUIRE(vol[celli] == Approx(sign*det(A)*mesh.V()[celli]).epsilon(1e-12));
-    }
     const label nCells = bsmTest::caseCells[0]*bsmTest::caseCells[1]*bsmTest::caseCells[2];
-    CHECK(returnReduce(nMirrored, sumOp<label>()) == nCells/2);
+    const bool hexKernel = GENERATE(true, false);
+    INFO("hexahedra " << (hexKernel ? "in vector lanes" : "as general cells"));
+    const invertedCellCheck check(mesh, hexKernel);
+
+    SECTION("the undisturbed mesh and a rigid motion have none")
+    {
+        const tensor R(0, -1, 0, 1, 0, 0, 0, 0, 1);
+        const pointField p((R & p0) + vector(3, -2, 1));
+        const invertedCellCheck::result r = check.check(p);
+        CHECK(r.nInvalid == 0);
+        CHECK(r.nJudged == 0);
+        CHECK(check.check(p0).nInvalid == 0);
+    }
+
+    SECTION("the box folded about a plane of points: the mirrored half")
+    {
+        // Every face stays planar; the cells below x = 1/2 are mirrored
+        // (negative volume), the others sheared and stretched only
+        const tensor A(1.2, 0.3, 0, 0, 0.9, 0.2, 0.1, 0, 1.1);
+        pointField p(p0.size());
+        forAll(p0, pointi)
+        {
+            vector x = p0[pointi];
+            x.x() = mag(x.x() - 0.5);
+            p[pointi] = (A & x) + vector(0.3, -0.2, 0.1);
+        }
+        const invertedCellCheck::result r = check.check(p);
+        CHECK(r.nInvalid == nCells/2);
+        CHECK(r.nNonPositive == nCells/2);
+        CHECK(r.nFolded == 0);
+        CHECK(r.nInvalid == checkMeshInvalidCells(mesh, p));
+        CHECK(r.where.max().x() < 0.3 + 1.2*0.5 + 0.3 + 1e-9);
+    }
+
+    SECTION("one point pushed into its neighbours: folded cells of positive volume")
+    {
+        // The mesh point at (0.3, 0.5, 0.5) pushed along (1, 1, 1) by a
+        // fraction of a cell's diagonal (0.1 x 0.125 x 0.1667): its eight
+        // cells fold before any turns inside out
+        const vector h(0.1, 0.125, 1.0/6);
+        label foldedOnly = 0;
+        for (const scalar s : {0.1, 0.3, 0.5, 0.7, 0.9, 1.2})
+        {
+            pointField p(p0);
+            forAll(p, pointi)
+            {
+                if (mag(p0[pointi] - vector(0.3, 0.5, 0.5)) < 1e-9)
+                {
+                    p[pointi] += s*h;
+                }
+            }
+            const invertedCellCheck::result r = check.check(p);
+            const label expected = checkMeshInvalidCells(mesh, p);
+            INFO("push " << s << ": " << r.nInvalid << " invalid (" << r.nNonPositive
+                << " non-positive, " << r.nFolded << " folded), checkMesh " << expected);
+            CHECK(r.nInvalid == expected);
+            CHECK(r.nInvalid == r.nNonPositive + r.nFolded);
+            if (r.nFolded > 0 && r.nNonPositive == 0) ++foldedOnly;
+            if (r.nInvalid > 0)
+            {
+                // (the invalid cells' centres lie next to the pushed point)
+                CHECK(mag(r.where.max() - (point(0.3, 0.5, 0.5) + s*h)) < mag(h));
+                CHECK(mag(r.where.min() - (point(0.3, 0.5, 0.5) + s*h)) < mag(h));
+            }
+        }
+        // Some pushes fold cells that keep a positive volume: the check
+        // that looked at volumes only let these through
+        CHECK(foldedOnly > 0);
+    }
 }
 
 

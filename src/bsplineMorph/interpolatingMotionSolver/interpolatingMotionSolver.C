@@ -19,7 +19,8 @@ License
 #include "clockTime.H"
 #include "Enum.H"
 #include "mapPolyMesh.H"
-#include "hugePages.hpp"
+#include "OStringStream.H"
+#include "setSizeOnHugePages.H"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
@@ -43,41 +44,46 @@ namespace Foam
                 "invertedCells", dict, onInverted::fatal
             ) == onInverted::fatal;
         }
-
-        //- Size a mesh-sized work array swept every step; when it is
-        //  allocated, ask for huge pages before it is first written (as the
-        //  core's arrays; best effort: malloc may hand out memory written
-        //  before, which keeps its pages)
-        template<class T>
-        void setSizeOnHugePages(List<T>& list, const label n)
-        {
-            if (list.size() != n)
-            {
-                list.setSize(n);
-                mba::adviseHugePages(list.data(), n*sizeof(T));
-            }
-        }
     }
 }
 
 
 // * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
-Foam::label Foam::interpolatingMotionSolver::nInvertedCells
+Foam::scalar Foam::interpolatingMotionSolver::checkCells
 (
     const pointField& points
-) const
+)
 {
-    signedCellVolumes(mesh(), points, cellVol_);
-    label n = 0;
-    for (const scalar v : cellVol_)
+    const clockTime timer;
+    if (!checkPtr_)
     {
-        if (!(v > 0))
-        {
-            ++n;
-        }
+        checkPtr_.reset(new invertedCellCheck(mesh()));
     }
-    return returnReduce(n, sumOp<label>());
+    const invertedCellCheck::result r = checkPtr_->check(points);
+    if (r.nInvalid == 0)
+    {
+        return timer.elapsedTime();
+    }
+    OStringStream what;
+    what<< r.nInvalid << " cells at time " << mesh().time().timeName()
+        << " (" << r.nNonPositive << " of non-positive volume, "
+        << r.nFolded << " folded: positive volume but a face pyramid"
+        << " wrongly oriented against the cell centre, as checkMesh counts"
+        << " them; cell centres within " << r.where << ")";
+    if (invertedCellsFatal_)
+    {
+        FatalErrorInFunction
+            << "The prescribed motion inverts " << what.str().c_str()
+            << "; the mesh is not moved."
+            << " Smaller motion steps, other " << type() << "Coeffs"
+            << " settings, or invertedCells warn (to continue anyway) are"
+            << " the options" << exit(FatalError);
+    }
+    WarningInFunction
+        << "The morphed mesh has " << r.nInvalid << " inverted cells: "
+        << what.str().c_str() << endl;
+    return timer.elapsedTime();
 }
 
 
@@ -312,25 +318,7 @@ void Foam::interpolatingMotionSolver::solve()
         newPoints_[pointi] = p0[pointi] + displacement[pointi];
     }
     twoDCorrectPoints(newPoints_);
-    const clockTime checkTimer;
-    const label nInverted = nInvertedCells(newPoints_);
-    const scalar checkSeconds = checkTimer.elapsedTime();
-    if (nInverted > 0)
-    {
-        if (invertedCellsFatal_)
-        {
-            FatalErrorInFunction
-                << "The prescribed motion inverts " << nInverted
-                << " cells at time " << mesh().time().timeName()
-                << " (non-positive volume); the mesh is not moved."
-                << " Smaller motion steps, other " << type() << "Coeffs"
-                << " settings, or invertedCells warn (to continue anyway) are"
-                << " the options" << exit(FatalError);
-        }
-        WarningInFunction
-            << "The morphed mesh has " << nInverted << " inverted cells at time "
-            << mesh().time().timeName() << endl;
-    }
+    const scalar checkSeconds = checkCells(newPoints_);
 
     // Evaluate the conditions (fixed values, processor patches), then keep
     // the constrained interpolant: slip conditions would re-project their
@@ -357,84 +345,6 @@ void Foam::interpolatingMotionSolver::solve()
 }
 
 
-void Foam::interpolatingMotionSolver::signedCellVolumes
-(
-    const polyMesh& mesh,
-    const pointField& points,
-    scalarField& vol
-)
-{
-    // Signed cell volumes (cell::mag sums absolute pyramid volumes, so it
-    // never sees an inverted cell): the divergence theorem over the faces,
-    // V = sum over a cell's faces of area vector . (face point - x0)/3 for
-    // any x0 (a closed cell's area vectors add up to 0), each face as its
-    // area vector (twice it: for a quad the cross product of its diagonals,
-    // else the triangles about its first vertex) and its vertex mean, x0 the
-    // centre of the mesh's bounds (for every cell: one term per face, added
-    // to its owner and taken from its neighbour). Exact for planar faces;
-    // one pass over the faces, no square roots, no face arrays.
-    const faceList& faces = mesh.faces();
-    const labelList& own = mesh.faceOwner();
-    const labelList& nei = mesh.faceNeighbour();
-    const point x0 = mesh.bounds().centre();
-    const scalar sixth = 1.0/6;   // (a third, of twice the area)
-    setSizeOnHugePages(vol, mesh.nCells());
-    vol = 0;
-    // (faces come in owner order: a face's term goes to its owner through a
-    // register while the owner stays the same; added to memory face after
-    // face, each would wait for the previous one's store)
-    label owner = own.empty() ? -1 : own[0];
-    scalar ownerSum = 0;
-    forAll(faces, facei)
-    {
-        // (a face's labels lie elsewhere: asked for some faces ahead)
-        if (facei + 32 < faces.size()) __builtin_prefetch(faces[facei + 32].cdata());
-        const face& f = faces[facei];
-        const point& p0 = points[f[0]];
-        vector mean, area;
-        if (f.size() == 4)
-        {
-            const point& p1 = points[f[1]];
-            const point& p2 = points[f[2]];
-            const point& p3 = points[f[3]];
-            mean = 0.25*(p0 + p1 + p2 + p3);
-            area = (p2 - p0) ^ (p3 - p1);
-        }
-        else
-        {
-            vector sum = p0;
-            area = Zero;
-            for (label i = 1; i < f.size(); ++i)
-            {
-                const point& p = points[f[i]];
-                sum += p;
-                if (i + 1 < f.size())
-                {
-                    area += (p - p0) ^ (points[f[i + 1]] - p0);
-                }
-            }
-            mean = sum/f.size();
-        }
-        const scalar v = (area & (mean - x0))*sixth;
-        if (own[facei] != owner)
-        {
-            vol[owner] += ownerSum;
-            owner = own[facei];
-            ownerSum = 0;
-        }
-        ownerSum += v;
-        if (facei < nei.size())
-        {
-            vol[nei[facei]] -= v;
-        }
-    }
-    if (owner >= 0)
-    {
-        vol[owner] += ownerSum;
-    }
-}
-
-
 void Foam::interpolatingMotionSolver::movePoints(const pointField& p)
 {
     displacementMotionSolver::movePoints(p);
@@ -453,6 +363,7 @@ void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
     }
     constraintsPtr_.reset();
     refitPtr_.reset();
+    checkPtr_.reset();
     evalPoints_.clear();
     evalXyz_.clear();
     newPoints_.clear();
