@@ -10,6 +10,9 @@
                                              with the hole's rigid motion (fitted to the hole);
                                              --slip-layers: and those within INNER of a sliding
                                              box face (x, y) keep their distance from it
+    checkPoints.py cyclic CASE box|sector    the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
+                                             the box's x faces, the sector's sides) have displacements
+                                             equal through the pair's transform at every written time
 
 Exit status 1 on any failed check; prints what it measured. Other test scripts
 import it for readPoints, readLabels, pointsAt and check (run from the project's
@@ -36,6 +39,38 @@ def check(cond, msg):
     print(("ok   " if cond else "FAIL ") + msg)
     if not cond:
         failures.append(msg)
+
+def cyclicPairs(case, kind):
+    import os
+    p0 = pointsAt(case, "constant")
+    if kind == "box":      # left (x = 0) -> right (x = 1): translate by (1 0 0)
+        onA = lambda p: abs(p[0]) < 1e-9
+        T = lambda v: (v[0] + 1.0, v[1], v[2])
+        R = lambda v: v
+    else:                  # side0 (y = 0) -> side90 (x = 0): turn by 90 deg about z
+        onA = lambda p: abs(p[1]) < 1e-9 and p[0] > 0.5
+        T = R = lambda v: (-v[1], v[0], v[2])
+    key = lambda p: tuple(round(x, 8) for x in p)
+    index = {key(p): i for i, p in enumerate(p0)}
+    A = [i for i, p in enumerate(p0) if onA(p)]
+    B = [index.get(key(T(p0[i]))) for i in A]
+    check(len(A) > 0 and None not in B, "%d point pairs matched through the transform" % len(A))
+    if failures:
+        return
+    times = sorted((t for t in os.listdir(case) if t.replace(".", "", 1).isdigit() and float(t) > 0
+                    and os.path.exists("%s/%s/polyMesh/points" % (case, t))), key=float)
+    check(len(times) > 0, "written times with points: %s" % " ".join(times))
+    for t in times:
+        p1 = pointsAt(case, t)
+        disp = lambda i: [p1[i][k] - p0[i][k] for k in range(3)]
+        diff = moved = 0.0
+        for a, b in zip(A, B):
+            da, db = R(disp(a)), disp(b)
+            diff = max(diff, max(abs(da[k] - db[k]) for k in range(3)))
+            moved = max(moved, max(abs(x) for x in db))
+        check(diff <= 1e-12, "time %s: paired displacements differ by at most %.3e (largest pair displacement %.3g)"
+              % (t, diff, moved))
+        check(moved > 1e-4, "time %s: the cyclic points moved (largest %.3g), the check is not vacuous" % (t, moved))
 
 def main():
     mode = sys.argv[1]
@@ -99,6 +134,8 @@ def main():
         if twoD:
             zErr = np.abs(p1[:, 2] - p0[:, 2]).max()
             check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)
+    elif mode == "cyclic":
+        cyclicPairs(sys.argv[2], sys.argv[3])
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv

@@ -18,6 +18,7 @@ License
 #include "boundaryConstraints.H"
 #include "valuePointPatchFields.H"
 #include "syncTools.H"
+#include "globalMeshData.H"
 #include "polyMesh.H"
 #include "facePointPatch.H"
 #include "emptyPointPatch.H"
@@ -25,6 +26,9 @@ License
 #include "OStringStream.H"
 #include "IStringStream.H"
 #include "HashOps.H"
+#include "cyclicPolyPatch.H"
+#include "processorPolyPatch.H"
+#include "processorCyclicPolyPatch.H"
 
 #include <cmath>
 
@@ -79,13 +83,25 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
 
-    // Ownership: the lowest rank holding a point
-    labelList owner(mesh.nPoints(), Pstream::myProcNo());
-    syncTools::syncPointList(mesh, owner, minEqOp<label>(), labelMax);
+    // Ownership: the lowest rank holding a point (its collocated copies
+    // only: the points a cyclic coupling joins are different points, each
+    // with its owner)
+    const globalMeshData& gd = mesh.globalData();
+    const labelList& coupledPoints = gd.coupledPatch().meshPoints();
+    labelList owner(coupledPoints.size(), Pstream::myProcNo());
+    globalMeshData::syncData
+    (
+        owner,
+        gd.globalCoPointSlaves(),
+        labelListList(0),
+        gd.globalCoPointSlavesMap(),
+        minEqOp<label>()
+    );
     owned_.setSize(mesh.nPoints());
-    forAll(owner, pointi)
+    owned_ = true;
+    forAll(coupledPoints, i)
     {
-        owned_[pointi] = owner[pointi] == Pstream::myProcNo();
+        owned_[coupledPoints[i]] = owner[i] == Pstream::myProcNo();
     }
 
     bitSet onPatch(mesh.nPoints());
@@ -97,6 +113,31 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
     boundaryPoints_ = onPatch.sortedToc();
+
+    // The points of cyclic couplings, and their copies on other ranks
+    // (through processor patches)
+    scalarField joined(mesh.nPoints(), 0);
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        const bool cyclicCoupling =
+            isA<processorCyclicPolyPatch>(pp)
+         || (isA<cyclicPolyPatch>(pp) && !isA<processorPolyPatch>(pp));
+        if (cyclicCoupling)
+        {
+            for (const label pointi : pp.meshPoints())
+            {
+                joined[pointi] = 1;
+            }
+        }
+    }
+    syncTools::syncPointList(mesh, joined, maxEqOp<scalar>(), scalar(0));
+    DynamicList<label> cyclic;
+    forAll(joined, pointi)
+    {
+        if (joined[pointi] > 0) cyclic.append(pointi);
+    }
+    cyclicPoints_.transfer(cyclic);
+    nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
 
     update(pointDisplacement);
 }
@@ -305,7 +346,93 @@ Foam::boundaryConstraints::boundaryConstraints
         fixed_[pointi] = true;
         value_[pointi] = displacement[pointi];
     }
+    for (const label pointi : bc.cyclicPoints_)
+    {
+        if (!bc.fixed_[pointi])
+        {
+            fixed_[pointi] = true;
+            value_[pointi] = displacement[pointi];
+        }
+    }
     collectControls();
+}
+
+
+void Foam::boundaryConstraints::checkCouplings
+(
+    const polyMesh& mesh,
+    const word& solver
+)
+{
+    // (cyclicAMI says it is not coupled(): the class tells)
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        if
+        (
+            isA<coupledPolyPatch>(pp)
+         && !isA<processorPolyPatch>(pp)
+         && !isA<cyclicPolyPatch>(pp)
+        )
+        {
+            FatalErrorInFunction
+                << "Patch " << pp.name() << " is a " << pp.type()
+                << " coupling, which " << solver << " does not support: its"
+                << " two sides would move apart. Supported couplings: cyclic"
+                << " (translational or rotational) and processor patches;"
+                << " the mesh is not moved" << exit(FatalError);
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
+{
+    if (nCyclicGlobal_ == 0)
+    {
+        return;
+    }
+    // Sums and counts over each set of joined points (syncPointList adds
+    // them, each transformed to the receiving point's side); fixed points
+    // keep their prescribed values (the same on every copy)
+    const polyMesh& mesh = pMesh_();
+    if (cyclicSum_.size() != mesh.nPoints())
+    {
+        // (zero at the points of processor patches too: syncPointList
+        // combines every coupled point)
+        cyclicSum_.setSize(mesh.nPoints(), Zero);
+        cyclicCount_.setSize(mesh.nPoints(), 0);
+    }
+    // (each point counted once: on the rank that owns it, not on those
+    // that hold a copy of it through a processor patch)
+    for (const label pointi : cyclicPoints_)
+    {
+        const bool counted = !fixed_[pointi] && owned_[pointi];
+        cyclicSum_[pointi] = counted ? displacement[pointi] : Zero;
+        cyclicCount_[pointi] = counted;
+    }
+    syncTools::syncPointList(mesh, cyclicSum_, plusEqOp<vector>(), vector::zero);
+    syncTools::syncPointList(mesh, cyclicCount_, plusEqOp<scalar>(), scalar(0));
+    for (const label pointi : cyclicPoints_)
+    {
+        if (!fixed_[pointi] && cyclicCount_[pointi] > 0)
+        {
+            displacement[pointi] = cyclicSum_[pointi]/cyclicCount_[pointi];
+        }
+    }
+    // (a point's copies on several ranks: sums added in different orders
+    // may differ in the last bit; every copy takes the same one)
+    if (Pstream::parRun())
+    {
+        for (const label pointi : cyclicPoints_)
+        {
+            cyclicSum_[pointi] = displacement[pointi];
+        }
+        syncTools::syncPointList(mesh, cyclicSum_, maxMagSqrEqOp<vector>(), vector::zero);
+        for (const label pointi : cyclicPoints_)
+        {
+            if (!fixed_[pointi]) displacement[pointi] = cyclicSum_[pointi];
+        }
+    }
 }
 
 
@@ -341,9 +468,9 @@ Foam::label Foam::boundaryConstraints::nControlGlobal() const
 }
 
 
-Foam::label Foam::boundaryConstraints::nProjectedGlobal() const
+Foam::label Foam::boundaryConstraints::nRefitGlobal() const
 {
-    return returnReduce(projected_.size(), sumOp<label>());
+    return returnReduce(projected_.size(), sumOp<label>()) + nCyclicGlobal_;
 }
 
 

@@ -178,7 +178,9 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     planned_{false, false},
     slot_(0)
-{}
+{
+    boundaryConstraints::checkCouplings(mesh, type);
+}
 
 
 Foam::interpolatingMotionSolver::interpolatingMotionSolver
@@ -195,7 +197,9 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     planned_{false, false},
     slot_(0)
-{}
+{
+    boundaryConstraints::checkCouplings(mesh, type);
+}
 
 
 // * * * * * * * * * * * * * * * * Destructor  * * * * * * * * * * * * * * * //
@@ -277,12 +281,14 @@ void Foam::interpolatingMotionSolver::solve()
         use(0, changed);
         summary = interpolateInto(displacement);
 
-        // Sliding planes not along the axes: project, then fit again with
-        // the projected points as control points, so that the interpolant
-        // (not only those points) follows the planes
-        if (constraintsPtr_->nProjectedGlobal() > 0)
+        // Sliding planes not along the axes: project; cyclic couplings: the
+        // joined points' mean. Then fit again with those points as control
+        // points, so that the interpolant (not only those points) follows the
+        // planes and is continuous across the cyclic pairs
+        if (constraintsPtr_->nRefitGlobal() > 0)
         {
             constraintsPtr_->constrain(displacement);
+            constraintsPtr_->matchCyclic(displacement);
             std::unique_ptr<boundaryConstraints> refit
             (
                 new boundaryConstraints(*constraintsPtr_, displacement)
@@ -291,7 +297,11 @@ void Foam::interpolatingMotionSolver::solve()
              || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
             refitPtr_ = std::move(refit);
             use(1, refitChanged);
-            summary += "; re-fit with the projected sliding points: " + interpolateInto(displacement);
+            summary +=
+                constraintsPtr_->nCyclicGlobal() > 0
+              ? "; re-fit with the projected sliding and cyclic points: "
+              : "; re-fit with the projected sliding points: ";
+            summary += interpolateInto(displacement);
             slot_ = 0;
         }
 
@@ -311,7 +321,8 @@ void Foam::interpolatingMotionSolver::solve()
         }
     }
     // The points the conditions fix or constrain (the interpolated ones
-    // moved already)
+    // moved already); the cyclic pairs matched exactly
+    constraintsPtr_->matchCyclic(displacement);
     constraintsPtr_->constrain(displacement);
     for (const label pointi : constraintsPtr_->boundaryPoints())
     {
