@@ -217,11 +217,12 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
 TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bsplineMorph][errors]")
 {
     using Catch::Matchers::Contains;
-    CHECK_THAT(errorOf("tolerance -1;"), Contains("tolerance"));
-    CHECK_THAT(errorOf("maxLevels 0;"), Contains("maxLevels"));
-    CHECK_THAT(errorOf("maxLevels 31;"), Contains("maxLevels"));
-    CHECK_THAT(errorOf("initialGrid 0;"), Contains("initialGrid"));
-    CHECK_THAT(errorOf("bucketTiles 0;"), Contains("bucketTiles"));
+    // (out of range: the entry, its value and the allowed range)
+    CHECK_THAT(errorOf("tolerance -1;"), Contains("tolerance") && Contains("-1") && Contains("at least 0"));
+    CHECK_THAT(errorOf("maxLevels 0;"), Contains("maxLevels") && Contains("from 1 to 30"));
+    CHECK_THAT(errorOf("maxLevels 100;"), Contains("'maxLevels' is 100") && Contains("from 1 to 30") && Contains("default 12"));
+    CHECK_THAT(errorOf("initialGrid 0;"), Contains("initialGrid") && Contains("from 1 to 1048576"));
+    CHECK_THAT(errorOf("bucketTiles 0;"), Contains("bucketTiles") && Contains("at least 1"));
     const std::string approx = errorOf("initialApproximation quadratic;");
     CHECK_THAT(approx, Contains("quadratic") && Contains("affine") && Contains("none"));
     const std::string inverted = errorOf("invertedCells maybe;");
@@ -264,7 +265,7 @@ TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][
         && Contains("thinPlateSpline") && Contains("wendlandC2"));
     CHECK_THAT(errorOf("shapeParameter 0;", "RBF"), Contains("shapeParameter"));
     CHECK_THAT(errorOf("supportRadius -1;", "RBF"), Contains("supportRadius"));
-    CHECK_THAT(errorOf("maxPoints 0;", "RBF"), Contains("maxPoints"));
+    CHECK_THAT(errorOf("maxPoints 0;", "RBF"), Contains("maxPoints") && Contains("at least 1") && Contains("default 20000"));
     CHECK_THAT(errorOf("greedyTolerance -1;", "RBF"), Contains("greedyTolerance"));
     CHECK_THAT(errorOf("greedyBatch 0;", "RBF"), Contains("greedyBatch"));
     CHECK_THAT(errorOf("function thinPlateSpline; polynomial false;", "RBF"),

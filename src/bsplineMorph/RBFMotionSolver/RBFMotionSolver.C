@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "RBFMotionSolver.H"
+#include "coeffsInput.H"
 #include "addToRunTimeSelectionTable.H"
 #include "OStringStream.H"
 #include "Enum.H"
@@ -54,16 +55,19 @@ void Foam::RBFMotionSolver::readCoeffs()
     params_.function =
         kernelNames.lookupOrDefault("function", dict, rbf::kernel::inverseMultiquadric);
     params_.shapeParameter =
-        dict.getCheckOrDefault<scalar>("shapeParameter", 0.05, scalarMinMax::ge(SMALL));
+        coeffsInput::getInRange<scalar>(dict, "shapeParameter", 0.05, SMALL);
     params_.supportRadius =
-        dict.getCheckOrDefault<scalar>("supportRadius", 0.5, scalarMinMax::ge(SMALL));
+        coeffsInput::getInRange<scalar>(dict, "supportRadius", 0.5, SMALL);
     params_.polynomial = dict.lookupOrDefault<bool>("polynomial", true);
-    params_.maxPoints =
-        dict.getCheckOrDefault<label>("maxPoints", 20000, labelMinMax::ge(1));
+    params_.maxPoints = coeffsInput::getInRange<label>(dict, "maxPoints", 20000, 1);
     params_.greedyTolerance =
-        dict.getCheckOrDefault<scalar>("greedyTolerance", 0, scalarMinMax::ge(0));
-    params_.greedyBatch =
-        dict.getCheckOrDefault<label>("greedyBatch", 50, labelMinMax::ge(1));
+        coeffsInput::getInRange<scalar>(dict, "greedyTolerance", 0, 0);
+    params_.greedyBatch = coeffsInput::getInRange<label>(dict, "greedyBatch", 50, 1);
+    warnUnknownKeywords
+    ({
+        "function", "shapeParameter", "supportRadius", "polynomial",
+        "maxPoints", "greedyTolerance", "greedyBatch"
+    });
     if (params_.function == rbf::kernel::thinPlateSpline && !params_.polynomial)
     {
         FatalIOErrorInFunction(dict)

@@ -71,7 +71,8 @@ Foam::boundaryConstraints::boundaryConstraints
     const pointVectorField& pointDisplacement
 )
 :
-    pMesh_(pointDisplacement.mesh())
+    pMesh_(pointDisplacement.mesh()),
+    nCyclicGlobal_(0)
 {
     const polyMesh& mesh = pMesh_();
     const Vector<label>& solD = mesh.solutionD();
@@ -180,6 +181,8 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
         }
     }
     wordHashSet badPatches;
+    wordHashSet emptyDirectionPatches;
+    const Vector<label>& solD = mesh.solutionD();
 
     forAll(pointDisplacement.boundaryField(), patchi)
     {
@@ -211,6 +214,10 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
                 for (direction c = 0; c < 3; ++c)
                 {
                     if (!std::isfinite(values[i][c])) badPatches.insert(pp.name());
+                    if (solD[c] != 1 && values[i][c] != 0)
+                    {
+                        emptyDirectionPatches.insert(pp.name());
+                    }
                 }
             }
         }
@@ -268,6 +275,27 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
             << flatOutput(badPatches.sortedToc()) << " at time "
             << mesh.time().timeName() << "; the mesh is not moved"
             << exit(FatalError);
+    }
+
+    // A 2D case moves in its plane: a prescribed component out of it is
+    // dropped, with a warning (once per patch)
+    Pstream::combineGather(emptyDirectionPatches, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(emptyDirectionPatches);
+    emptyDirectionPatches -= warnedEmptyDirection_;
+    if (emptyDirectionPatches.size())
+    {
+        OStringStream names;
+        for (const word& name : emptyDirectionPatches.sortedToc())
+        {
+            names<< ' ' << name;
+        }
+        WarningInFunction
+            << "pointDisplacement prescribes a non-zero displacement in the"
+            << " empty direction of this 2D case on patches:"
+            << names.str().c_str() << ", at time "
+            << mesh.time().timeName() << ": that component is dropped (the"
+            << " mesh moves in its plane only)" << endl;
+        warnedEmptyDirection_ += emptyDirectionPatches;
     }
 
     // The same view of every processor-shared point on all its ranks
@@ -339,7 +367,9 @@ Foam::boundaryConstraints::boundaryConstraints
     value_(bc.value_),
     slide_(bc.slide_),
     owned_(bc.owned_),
-    boundaryPoints_(bc.boundaryPoints_)
+    boundaryPoints_(bc.boundaryPoints_),
+    cyclicPoints_(bc.cyclicPoints_),
+    nCyclicGlobal_(bc.nCyclicGlobal_)
 {
     for (const label pointi : bc.projected_)
     {

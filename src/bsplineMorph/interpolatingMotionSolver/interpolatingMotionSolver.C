@@ -20,6 +20,7 @@ License
 #include "Enum.H"
 #include "mapPolyMesh.H"
 #include "OStringStream.H"
+#include "coeffsInput.H"
 #include "setSizeOnHugePages.H"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
@@ -146,6 +147,23 @@ std::string Foam::interpolatingMotionSolver::interpolateInto
         newPoints_[pointi] = p0[pointi] + d;
     }
     return summary;
+}
+
+
+void Foam::interpolatingMotionSolver::warnUnknownKeywords
+(
+    const wordList& known
+) const
+{
+    const dictionary& dict = coeffDict();
+    if (dict.dictName() != word(type() + "Coeffs"))
+    {
+        return;
+    }
+    wordList all(known);
+    all.append("invertedCells");
+    all.append("rigidLayers");
+    coeffsInput::warnUnknown(dict, all);
 }
 
 

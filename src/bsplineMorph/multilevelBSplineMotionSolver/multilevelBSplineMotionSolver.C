@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "multilevelBSplineMotionSolver.H"
+#include "coeffsInput.H"
 #include "addToRunTimeSelectionTable.H"
 #include "OStringStream.H"
 #include "Enum.H"
@@ -60,20 +61,22 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
 {
     const dictionary& dict = coeffDict();
 
-    params_.tolerance =
-        dict.getCheckOrDefault<scalar>("tolerance", 1e-6, scalarMinMax::ge(0));
+    params_.tolerance = coeffsInput::getInRange<scalar>(dict, "tolerance", 1e-6, 0);
     params_.relative = dict.lookupOrDefault<bool>("relativeTolerance", true);
-    params_.maxLevels =
-        dict.getCheckOrDefault<label>("maxLevels", 12, labelMinMax(1, 30));
+    params_.maxLevels = coeffsInput::getInRange<label>(dict, "maxLevels", 12, 1, 30);
     params_.initialGrid =
-        dict.getCheckOrDefault<label>("initialGrid", 1, labelMinMax(1, 1 << 20));
+        coeffsInput::getInRange<label>(dict, "initialGrid", 1, 1, 1 << 20);
     params_.affine =
         initialApproximationNames.lookupOrDefault
         (
             "initialApproximation", dict, initialApproximation::affine
         ) == initialApproximation::affine;
-    params_.bucketTiles =
-        dict.getCheckOrDefault<label>("bucketTiles", 32, labelMinMax::ge(1));
+    params_.bucketTiles = coeffsInput::getInRange<label>(dict, "bucketTiles", 32, 1);
+    warnUnknownKeywords
+    ({
+        "tolerance", "relativeTolerance", "maxLevels", "initialGrid",
+        "initialApproximation", "bucketTiles"
+    });
 }
 
 

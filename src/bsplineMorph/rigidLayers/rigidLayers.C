@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "rigidLayers.H"
+#include "coeffsInput.H"
 #include "boundaryConstraints.H"
 #include "emptyPolyPatch.H"
 #include "syncTools.H"
@@ -107,6 +108,9 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     nSmooth_(0),
     transformsFinal_(false)
 {
+    // (a misspelt keyword named before a required one is found missing)
+    coeffsInput::warnUnknown(dict, {"patches", "innerDistance", "outerDistance"});
+
     // Patches: every pattern must match a patch that can carry layers
     const wordRes patterns(dict.get<wordRes>("patches"));
     const polyBoundaryMesh& pbm = mesh.boundaryMesh();
@@ -148,8 +152,8 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     }
     patchIDs_ = ids.sortedToc();
 
-    innerDistance_ = dict.getCheck<scalar>("innerDistance", scalarMinMax::ge(0));
-    outerDistance_ = dict.getCheck<scalar>("outerDistance", scalarMinMax::ge(0));
+    innerDistance_ = coeffsInput::getRequiredInRange<scalar>(dict, "innerDistance", 0);
+    outerDistance_ = coeffsInput::getRequiredInRange<scalar>(dict, "outerDistance", 0);
     if (!(outerDistance_ > innerDistance_))
     {
         FatalIOErrorInFunction(dict)
