@@ -43,7 +43,124 @@ namespace Foam
             { rbf::kernel::thinPlateSpline, "thinPlateSpline" },
             { rbf::kernel::wendlandC2, "wendlandC2" },
         });
+
+        //- RBF interpolants in D dimensions, one per solution direction,
+        //  each centred on the control points that constrain that direction
+        template<int D>
+        class rbfInterpolator
+        :
+            public boundaryInterpolator
+        {
+            //- Per direction: indices into the control points, and their
+            //  coordinates (which the interpolant views)
+            std::vector<std::vector<label>> selected_;
+            std::vector<std::vector<double>> controlXyz_;
+
+            //- Per direction: the interpolant
+            std::vector<std::unique_ptr<rbf::interpolant<D>>> rbf_;
+
+            //- The evaluation points
+            const mba::pointsView<D> eval_;
+
+        public:
+
+            rbfInterpolator
+            (
+                const mba::communicator& comm,
+                const rbf::params& params,
+                const boundaryConstraints& bc,
+                const pointField& points0,
+                const double* evalXyz,
+                const std::size_t nEval
+            );
+
+            //- Fit each direction's values, evaluate at the evaluation
+            //  points
+            virtual std::string interpolate
+            (
+                const boundaryConstraints& bc,
+                std::vector<double>& result
+            );
+        };
     }
+}
+
+
+// * * * * * * * * * * * * * Local Member Functions  * * * * * * * * * * * * //
+
+template<int D>
+Foam::rbfInterpolator<D>::rbfInterpolator
+(
+    const mba::communicator& comm,
+    const rbf::params& params,
+    const boundaryConstraints& bc,
+    const pointField& points0,
+    const double* evalXyz,
+    const std::size_t nEval
+)
+:
+    selected_(D),
+    controlXyz_(D),
+    eval_(evalXyz, nEval)
+{
+    const labelList& dirs = bc.directions();
+    forAll(bc.controlPoints(), i)
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            if (!bc.mask()[i*D + k]) continue;
+            selected_[k].push_back(i);
+            for (const label d : dirs)
+            {
+                controlXyz_[k].push_back(points0[bc.controlPoints()[i]][d]);
+            }
+        }
+    }
+    for (label k = 0; k < D; ++k)
+    {
+        const std::size_t n = selected_[k].size();
+        rbf_.emplace_back(new rbf::interpolant<D>
+            (comm, params, 1, mba::pointsView<D>(controlXyz_[k].data(), n)));
+    }
+}
+
+
+template<int D>
+std::string Foam::rbfInterpolator<D>::interpolate
+(
+    const boundaryConstraints& bc,
+    std::vector<double>& result
+)
+{
+    const std::size_t nEval = eval_.size;
+    std::vector<double> values, out;
+    result.resize(D*nEval);
+    label size = 0;
+    scalar rcond = GREAT;
+    try
+    {
+        for (label k = 0; k < D; ++k)
+        {
+            values.clear();
+            for (const label i : selected_[k]) values.push_back(bc.values()[i*D + k]);
+            rbf_[k]->fit(values);
+            rbf_[k]->evaluate(eval_, out);
+            for (std::size_t i = 0; i < nEval; ++i)
+            {
+                result[i*D + k] = out[i];
+            }
+            size = max(size, label(rbf_[k]->stats().size));
+            rcond = min(rcond, rbf_[k]->stats().rcond);
+        }
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction << "RBF interpolation failed: " << e.what() << exit(FatalError);
+    }
+    OStringStream os;
+    os  << D << " systems of size up to " << size
+        << ", reciprocal condition " << rcond;
+    return os.str();
 }
 
 
@@ -73,47 +190,6 @@ void Foam::RBFMotionSolver::readCoeffs()
         FatalIOErrorInFunction(dict)
             << "function thinPlateSpline needs polynomial true" << exit(FatalIOError);
     }
-}
-
-
-template<int D>
-std::string Foam::RBFMotionSolver::interpolateD
-(
-    std::vector<std::unique_ptr<rbf::interpolant<D>>>& rbf,
-    std::vector<double>& result
-)
-{
-    const boundaryConstraints& bc = constraints();
-    const labelList& points = evalPoints();
-    const mba::pointsView<D> eval(evalCoordinates(), std::size_t(points.size()));
-    std::vector<double> values, out;
-    result.resize(D*points.size());
-    label size = 0;
-    scalar rcond = GREAT;
-    try
-    {
-        for (label k = 0; k < D; ++k)
-        {
-            values.clear();
-            for (const label i : selected_[slot()][k]) values.push_back(bc.values()[i*D + k]);
-            rbf[k]->fit(values);
-            rbf[k]->evaluate(eval, out);
-            forAll(points, i)
-            {
-                result[i*D + k] = out[i];
-            }
-            size = max(size, label(rbf[k]->stats().size));
-            rcond = min(rcond, rbf[k]->stats().rcond);
-        }
-    }
-    catch (const std::exception& e)
-    {
-        FatalErrorInFunction << "RBF interpolation failed: " << e.what() << exit(FatalError);
-    }
-    OStringStream os;
-    os  << D << " systems of size up to " << size
-        << ", reciprocal condition " << rcond;
-    return os.str();
 }
 
 
@@ -153,45 +229,28 @@ Foam::RBFMotionSolver::~RBFMotionSolver()
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-void Foam::RBFMotionSolver::buildPlan()
+std::unique_ptr<Foam::boundaryInterpolator>
+Foam::RBFMotionSolver::newInterpolator
+(
+    const boundaryConstraints& bc,
+    const bool refit
+)
 {
-    const boundaryConstraints& bc = constraints();
-    const labelList& dirs = bc.directions();
-    const label D = dirs.size();
-    const pointField& p0 = points0();
+    const label D = bc.directions().size();
+    const std::size_t nEval = evalPoints().size();
     const clockTime timer;
-
-    selected_[slot()].assign(D, {});
-    controlXyz_[slot()].assign(D, {});
-    forAll(bc.controlPoints(), i)
-    {
-        for (label k = 0; k < D; ++k)
-        {
-            if (!bc.mask()[i*D + k]) continue;
-            selected_[slot()][k].push_back(i);
-            for (const label d : dirs)
-            {
-                controlXyz_[slot()][k].push_back(p0[bc.controlPoints()[i]][d]);
-            }
-        }
-    }
-    rbf3_[slot()].clear();
-    rbf2_[slot()].clear();
+    std::unique_ptr<boundaryInterpolator> interpolator;
     try
     {
-        for (label k = 0; k < D; ++k)
+        if (D == 3)
         {
-            const std::size_t n = selected_[slot()][k].size();
-            if (D == 3)
-            {
-                rbf3_[slot()].emplace_back(new rbf::interpolant<3>
-                    (comm_, params_, 1, mba::pointsView<3>(controlXyz_[slot()][k].data(), n)));
-            }
-            else
-            {
-                rbf2_[slot()].emplace_back(new rbf::interpolant<2>
-                    (comm_, params_, 1, mba::pointsView<2>(controlXyz_[slot()][k].data(), n)));
-            }
+            interpolator.reset(new rbfInterpolator<3>
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+        }
+        else
+        {
+            interpolator.reset(new rbfInterpolator<2>
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
         }
     }
     catch (const std::exception& e)
@@ -202,16 +261,7 @@ void Foam::RBFMotionSolver::buildPlan()
     Info<< type() << ": " << kernelNames[params_.function] << " systems for "
         << bc.nControlGlobal() << " control points factored in "
         << timer.elapsedTime() << " s" << endl;
-}
-
-
-std::string Foam::RBFMotionSolver::interpolate(std::vector<double>& values)
-{
-    if (!rbf3_[slot()].empty())
-    {
-        return interpolateD(rbf3_[slot()], values);
-    }
-    return interpolateD(rbf2_[slot()], values);
+    return interpolator;
 }
 
 

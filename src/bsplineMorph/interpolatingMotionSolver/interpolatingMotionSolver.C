@@ -109,17 +109,19 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
     {
         for (const label d : dirs) evalXyz_.push_back(p0[pointi][d]);
     }
-    // The re-fit plan evaluates these points too
-    planned_[1] = false;
+    // The re-fit interpolator evaluates these points too
+    refitInterpolatorPtr_.reset();
 }
 
 
 std::string Foam::interpolatingMotionSolver::interpolateInto
 (
+    boundaryInterpolator& interpolator,
+    const boundaryConstraints& bc,
     vectorField& displacement
 )
 {
-    const std::string summary = interpolate(values_);
+    const std::string summary = interpolator.interpolate(bc, values_);
     // The interpolated points' displacement (zero outside the solution
     // directions) and their moved points, in one pass
     // (each component read from its packed value or zero, into registers:
@@ -167,17 +169,22 @@ void Foam::interpolatingMotionSolver::warnUnknownKeywords
 }
 
 
-void Foam::interpolatingMotionSolver::use(const label slot, const bool changed)
+void Foam::interpolatingMotionSolver::plan
+(
+    std::unique_ptr<boundaryInterpolator>& interpolator,
+    const boundaryConstraints& bc,
+    const bool refit,
+    const bool changed
+)
 {
-    slot_ = slot;
-    if (returnReduce(changed, orOp<bool>()) || !planned_[slot])
+    if (returnReduce(changed, orOp<bool>()) || !interpolator)
     {
-        if (slot == 0)
+        if (!refit)
         {
             setEvalPoints();
         }
-        buildPlan();
-        planned_[slot] = true;
+        interpolator.reset();
+        interpolator = newInterpolator(bc, refit);
     }
 }
 
@@ -193,9 +200,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
-    planned_{false, false},
-    slot_(0)
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(mesh, type);
 }
@@ -212,9 +217,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
-    planned_{false, false},
-    slot_(0)
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(mesh, type);
 }
@@ -241,11 +244,8 @@ Foam::interpolatingMotionSolver::curPoints() const
 }
 
 
-void Foam::interpolatingMotionSolver::solve()
+bool Foam::interpolatingMotionSolver::updateControls()
 {
-    const clockTime timer;
-    std::string summary;
-
     // The boundary conditions give the prescribed displacements
     pointDisplacement_.boundaryFieldRef().updateCoeffs();
     pointDisplacement_.correctBoundaryConditions();
@@ -274,72 +274,69 @@ void Foam::interpolatingMotionSolver::solve()
         }
         rigidLayersPtr_->addControls(*constraintsPtr_, points0());
     }
-    const bool changed = first || !constraintsPtr_->sameControls(points, mask);
+    return first || !constraintsPtr_->sameControls(points, mask);
+}
 
-    // The displacement is worked out in pointDisplacement's own values (the
-    // conditions have been read), and the moved points beside it: every point
-    // is set below, the interpolated ones by interpolateInto (zero outside the
-    // solution directions), the fixed ones by constrain, which also zeroes the
-    // directions a 2D mesh does not solve for
-    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
-    const pointField& p0 = points0();
-    setSizeOnHugePages(newPoints_, p0.size());
-    slot_ = 0;
-    if (constraintsPtr_->nControlGlobal() == 0)
+
+std::string Foam::interpolatingMotionSolver::interpolateField
+(
+    vectorField& displacement,
+    const bool changed
+)
+{
+    boundaryConstraints& bc = *constraintsPtr_;
+    plan(interpolatorPtr_, bc, false, changed);
+    std::string summary = interpolateInto(*interpolatorPtr_, bc, displacement);
+
+    // Sliding planes not along the axes: project; cyclic couplings: the
+    // joined points' mean. Then fit again with those points as control
+    // points, so that the interpolant (not only those points) follows the
+    // planes and is continuous across the cyclic pairs
+    if (bc.nRefitGlobal() > 0)
     {
-        WarningInFunction
-            << "No control points: no patch of pointDisplacement fixes a value"
-            << " or slides; the mesh keeps its initial points" << endl;
-        displacement = Zero;
-        newPoints_ = p0;
-        clearPlan();
+        bc.constrain(displacement);
+        bc.matchCyclic(displacement);
+        std::unique_ptr<boundaryConstraints> refit
+        (
+            new boundaryConstraints(bc, displacement)
+        );
+        const bool refitChanged = !refitPtr_
+         || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
+        refitPtr_ = std::move(refit);
+        plan(refitInterpolatorPtr_, *refitPtr_, true, refitChanged);
+        summary +=
+            bc.nCyclicGlobal() > 0
+          ? "; re-fit with the projected sliding and cyclic points: "
+          : "; re-fit with the projected sliding points: ";
+        summary += interpolateInto(*refitInterpolatorPtr_, *refitPtr_, displacement);
     }
-    else
+
+    // The layers near the listed walls move with them (from the walls'
+    // final displacement: the boundary points constrained first)
+    if (rigidLayersPtr_)
     {
-        use(0, changed);
-        summary = interpolateInto(displacement);
-
-        // Sliding planes not along the axes: project; cyclic couplings: the
-        // joined points' mean. Then fit again with those points as control
-        // points, so that the interpolant (not only those points) follows the
-        // planes and is continuous across the cyclic pairs
-        if (constraintsPtr_->nRefitGlobal() > 0)
-        {
-            constraintsPtr_->constrain(displacement);
-            constraintsPtr_->matchCyclic(displacement);
-            std::unique_ptr<boundaryConstraints> refit
-            (
-                new boundaryConstraints(*constraintsPtr_, displacement)
-            );
-            const bool refitChanged = !refitPtr_
-             || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
-            refitPtr_ = std::move(refit);
-            use(1, refitChanged);
-            summary +=
-                constraintsPtr_->nCyclicGlobal() > 0
-              ? "; re-fit with the projected sliding and cyclic points: "
-              : "; re-fit with the projected sliding points: ";
-            summary += interpolateInto(displacement);
-            slot_ = 0;
-        }
-
-        // The layers near the listed walls move with them (from the walls'
-        // final displacement: the boundary points constrained first)
-        if (rigidLayersPtr_)
-        {
-            constraintsPtr_->constrain(displacement);
-            rigidLayersPtr_->apply
-            (
-                p0,
-                constraintsPtr_->fixed(),
-                constraintsPtr_->directions(),
-                displacement,
-                newPoints_
-            );
-        }
+        bc.constrain(displacement);
+        rigidLayersPtr_->apply
+        (
+            points0(),
+            bc.fixed(),
+            bc.directions(),
+            displacement,
+            newPoints_
+        );
     }
+    return summary;
+}
+
+
+void Foam::interpolatingMotionSolver::moveBoundaryPoints
+(
+    vectorField& displacement
+)
+{
     // The points the conditions fix or constrain (the interpolated ones
     // moved already); the cyclic pairs matched exactly
+    const pointField& p0 = points0();
     constraintsPtr_->matchCyclic(displacement);
     constraintsPtr_->constrain(displacement);
     for (const label pointi : constraintsPtr_->boundaryPoints())
@@ -347,8 +344,14 @@ void Foam::interpolatingMotionSolver::solve()
         newPoints_[pointi] = p0[pointi] + displacement[pointi];
     }
     twoDCorrectPoints(newPoints_);
-    const scalar checkSeconds = checkCells(newPoints_);
+}
 
+
+void Foam::interpolatingMotionSolver::correctBoundaryValues
+(
+    vectorField& displacement
+)
+{
     // Evaluate the conditions (fixed values, processor patches), then keep
     // the constrained interpolant: slip conditions would re-project their
     // points with their own point normals, which on a rank hold only that
@@ -365,6 +368,38 @@ void Foam::interpolatingMotionSolver::solve()
     {
         displacement[bp[i]] = boundaryValues_[i];
     }
+}
+
+
+void Foam::interpolatingMotionSolver::solve()
+{
+    const clockTime timer;
+    const bool changed = updateControls();
+
+    // The displacement is worked out in pointDisplacement's own values (the
+    // conditions have been read), and the moved points beside it: every point
+    // is set, the interpolated ones by interpolateField (zero outside the
+    // solution directions), the boundary ones by moveBoundaryPoints, which
+    // also zeroes the directions a 2D mesh does not solve for
+    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
+    setSizeOnHugePages(newPoints_, points0().size());
+    std::string summary;
+    if (constraintsPtr_->nControlGlobal() == 0)
+    {
+        WarningInFunction
+            << "No control points: no patch of pointDisplacement fixes a value"
+            << " or slides; the mesh keeps its initial points" << endl;
+        displacement = Zero;
+        newPoints_ = points0();
+        clearPlan();
+    }
+    else
+    {
+        summary = interpolateField(displacement, changed);
+    }
+    moveBoundaryPoints(displacement);
+    const scalar checkSeconds = checkCells(newPoints_);
+    correctBoundaryValues(displacement);
 
     if (!summary.empty())
     {

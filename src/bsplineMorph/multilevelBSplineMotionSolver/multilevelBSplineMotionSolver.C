@@ -51,7 +51,128 @@ namespace Foam
             { initialApproximation::none, "none" },
         });
 
+        //- The control points of bc (points0 in the solution directions,
+        //  packed)
+        std::vector<double> controlCoordinates
+        (
+            const boundaryConstraints& bc,
+            const pointField& points0
+        )
+        {
+            std::vector<double> xyz;
+            xyz.reserve(bc.directions().size()*bc.controlPoints().size());
+            for (const label pointi : bc.controlPoints())
+            {
+                for (const label d : bc.directions()) xyz.push_back(points0[pointi][d]);
+            }
+            return xyz;
+        }
+
+        //- A multilevel B-spline plan in D dimensions: its control points'
+        //  coordinates (which the plan views) and the plan
+        template<int D>
+        class bsplineInterpolator
+        :
+            public boundaryInterpolator
+        {
+            //- The control points' coordinates (declared before plan_,
+            //  which views them)
+            const std::vector<double> controlXyz_;
+
+            mba::multilevel<D> plan_;
+
+        public:
+
+            bsplineInterpolator
+            (
+                const mba::communicator& comm,
+                const mba::params& params,
+                const boundaryConstraints& bc,
+                const pointField& points0,
+                const double* evalXyz,
+                const std::size_t nEval
+            )
+            :
+                controlXyz_(controlCoordinates(bc, points0)),
+                plan_
+                (
+                    comm, params, D,
+                    mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
+                    bc.mask(), mba::pointsView<D>(evalXyz, nEval)
+                )
+            {}
+
+            //- Fit the control values, evaluate at the evaluation points
+            virtual std::string interpolate
+            (
+                const boundaryConstraints& bc,
+                std::vector<double>& values
+            );
+        };
     }
+}
+
+
+// * * * * * * * * * * * * * Local Member Functions  * * * * * * * * * * * * //
+
+template<int D>
+std::string Foam::bsplineInterpolator<D>::interpolate
+(
+    const boundaryConstraints& bc,
+    std::vector<double>& values
+)
+{
+    scalar evalSeconds = 0;
+    try
+    {
+        plan_.fit(bc.values());
+        const clockTime timer;
+        plan_.evaluate(values);
+        evalSeconds = timer.elapsedTime();
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction
+            << "Multilevel B-spline fit failed: " << e.what() << exit(FatalError);
+    }
+
+    const mba::fitReport& r = plan_.report();
+    const word& type = multilevelBSplineMotionSolver::typeName;
+    double nodes = 0, bytes = 0, messages = 0;
+    label separated = 0;
+    for (const mba::levelStats& s : plan_.stats())
+    {
+        if (s.level < r.levels)
+        {
+            separated += s.separated;
+            nodes += s.nodes;
+            bytes += s.bytesReceivedPerApply;
+            messages += s.messagesReceived;
+            if (multilevelBSplineMotionSolver::debug)
+            {
+                Pout<< type << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
+                    << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
+                    << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
+                    << " received " << s.bytesReceivedPerApply
+                    << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
+                    << s.planSeconds << " s)" << endl;
+            }
+        }
+    }
+    nodes = returnReduce(nodes, sumOp<scalar>());
+    const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
+    bytes = returnReduce(bytes, sumOp<scalar>());
+    const scalar messagesMax = returnReduce(messages, maxOp<scalar>());
+    messages = returnReduce(messages, sumOp<scalar>());
+    const scalar planMB = returnReduce(scalar(plan_.bytes()), sumOp<scalar>())/1048576;
+    OStringStream os;
+    os  << r.levels << " levels (" << separated << " separated), max residual " << r.maxResidual
+        << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
+        << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
+        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
+        << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
+        << r.seconds << " s, evaluation " << evalSeconds << " s";
+    return os.str();
 }
 
 
@@ -77,131 +198,6 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
         "tolerance", "relativeTolerance", "maxLevels", "initialGrid",
         "initialApproximation", "bucketTiles"
     });
-}
-
-
-void Foam::multilevelBSplineMotionSolver::buildPlan()
-{
-    const boundaryConstraints& bc = constraints();
-    std::vector<double>& controlXyz = controlXyz_[slot()];
-    std::unique_ptr<mba::multilevel<3>>& plan3 = plan3_[slot()];
-    std::unique_ptr<mba::multilevel<2>>& plan2 = plan2_[slot()];
-    const labelList& dirs = bc.directions();
-    const label D = dirs.size();
-    const pointField& p0 = points0();
-
-    controlXyz.clear();
-    for (const label pointi : bc.controlPoints())
-    {
-        for (const label d : dirs) controlXyz.push_back(p0[pointi][d]);
-    }
-    plan3.reset();
-    plan2.reset();
-    try
-    {
-        const std::size_t nEval = evalPoints().size();
-        if (D == 3)
-        {
-            plan3.reset
-            (
-                new mba::multilevel<3>
-                (
-                    comm_, params_, 3,
-                    mba::pointsView<3>(controlXyz.data(), bc.controlPoints().size()),
-                    bc.mask(), mba::pointsView<3>(evalCoordinates(), nEval)
-                )
-            );
-        }
-        else if (D == 2)
-        {
-            plan2.reset
-            (
-                new mba::multilevel<2>
-                (
-                    comm_, params_, 2,
-                    mba::pointsView<2>(controlXyz.data(), bc.controlPoints().size()),
-                    bc.mask(), mba::pointsView<2>(evalCoordinates(), nEval)
-                )
-            );
-        }
-        else
-        {
-            FatalErrorInFunction
-                << "Meshes with " << D << " solution directions are not supported"
-                << " (2D or 3D only)" << exit(FatalError);
-        }
-    }
-    catch (const std::exception& e)
-    {
-        FatalErrorInFunction
-            << "Cannot set up the multilevel B-spline plan: " << e.what()
-            << exit(FatalError);
-    }
-    Info<< type() << ": " << (slot() ? "re-fit " : "") << "plan for "
-        << bc.nControlGlobal() << " control points, "
-        << returnReduce(p0.size(), sumOp<label>()) << " mesh points ("
-        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D"
-        << endl;
-}
-
-
-template<int D>
-std::string Foam::multilevelBSplineMotionSolver::morph
-(
-    mba::multilevel<D>& plan,
-    std::vector<double>& values
-)
-{
-    scalar evalSeconds = 0;
-    try
-    {
-        plan.fit(constraints().values());
-        const clockTime timer;
-        plan.evaluate(values);
-        evalSeconds = timer.elapsedTime();
-    }
-    catch (const std::exception& e)
-    {
-        FatalErrorInFunction
-            << "Multilevel B-spline fit failed: " << e.what() << exit(FatalError);
-    }
-
-    const mba::fitReport& r = plan.report();
-    double nodes = 0, bytes = 0, messages = 0;
-    label separated = 0;
-    for (const mba::levelStats& s : plan.stats())
-    {
-        if (s.level < r.levels)
-        {
-            separated += s.separated;
-            nodes += s.nodes;
-            bytes += s.bytesReceivedPerApply;
-            messages += s.messagesReceived;
-            if (debug)
-            {
-                Pout<< type() << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
-                    << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
-                    << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
-                    << " received " << s.bytesReceivedPerApply
-                    << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
-                    << s.planSeconds << " s)" << endl;
-            }
-        }
-    }
-    nodes = returnReduce(nodes, sumOp<scalar>());
-    const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
-    bytes = returnReduce(bytes, sumOp<scalar>());
-    const scalar messagesMax = returnReduce(messages, maxOp<scalar>());
-    messages = returnReduce(messages, sumOp<scalar>());
-    const scalar planMB = returnReduce(scalar(plan.bytes()), sumOp<scalar>())/1048576;
-    OStringStream os;
-    os  << r.levels << " levels (" << separated << " separated), max residual " << r.maxResidual
-        << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
-        << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
-        << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
-        << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
-        << r.seconds << " s, evaluation " << evalSeconds << " s";
-    return os.str();
 }
 
 
@@ -241,16 +237,47 @@ Foam::multilevelBSplineMotionSolver::~multilevelBSplineMotionSolver()
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-std::string Foam::multilevelBSplineMotionSolver::interpolate
+std::unique_ptr<Foam::boundaryInterpolator>
+Foam::multilevelBSplineMotionSolver::newInterpolator
 (
-    std::vector<double>& values
+    const boundaryConstraints& bc,
+    const bool refit
 )
 {
-    if (plan3_[slot()])
+    const label D = bc.directions().size();
+    const std::size_t nEval = evalPoints().size();
+    std::unique_ptr<boundaryInterpolator> interpolator;
+    try
     {
-        return morph(*plan3_[slot()], values);
+        if (D == 3)
+        {
+            interpolator.reset(new bsplineInterpolator<3>
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+        }
+        else if (D == 2)
+        {
+            interpolator.reset(new bsplineInterpolator<2>
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+        }
+        else
+        {
+            FatalErrorInFunction
+                << "Meshes with " << D << " solution directions are not supported"
+                << " (2D or 3D only)" << exit(FatalError);
+        }
     }
-    return morph(*plan2_[slot()], values);
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction
+            << "Cannot set up the multilevel B-spline plan: " << e.what()
+            << exit(FatalError);
+    }
+    Info<< type() << ": " << (refit ? "re-fit " : "") << "plan for "
+        << bc.nControlGlobal() << " control points, "
+        << returnReduce(points0().size(), sumOp<label>()) << " mesh points ("
+        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D"
+        << endl;
+    return interpolator;
 }
 
 
