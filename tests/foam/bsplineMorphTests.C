@@ -66,6 +66,33 @@ namespace
         }
     }
 
+    // Walls displaced by the affine field a + B x: every point of the mesh
+    // moves by exactly a + B x (to tol), serial or on any number of ranks
+    void requireAffine(motionSolver& solver, const scalar tol)
+    {
+        const vector a(0.05, -0.02, 0.03);
+        const tensor B(0.02, -0.1, 0.03, 0.1, 0.01, -0.04, -0.02, 0.05, 0.03);
+        displacementMotionSolver& dms = refCast<displacementMotionSolver>(solver);
+        const label patchi = bsmTest::mesh().boundaryMesh().findPatchID("walls");
+        REQUIRE(patchi >= 0);
+        pointPatchVectorField& pf = dms.pointDisplacement().boundaryFieldRef()[patchi];
+        const vectorField x(pf.patch().localPoints());
+        pf == vectorField(a + (B & x));
+        solver.solve();
+        const pointField p1(solver.curPoints());
+        const pointField& p0 = bsmTest::mesh().points();
+        scalar worst = 0;
+        forAll(p0, pointi)
+        {
+            worst = max(worst, mag(p1[pointi] - (p0[pointi] + a + (B & p0[pointi]))));
+        }
+        worst = returnReduce(worst, maxOp<scalar>());
+        INFO("largest departure from x + a + B x: " << worst);
+        CHECK(worst <= tol);
+        // (and the points moved: a displacement of about 0.1)
+        CHECK(returnReduce(max(mag(p1 - p0)), maxOp<scalar>()) > 0.05);
+    }
+
     std::string errorOf(const std::string& coeffs, const std::string& type = "multilevelBSpline")
     {
         try
@@ -133,6 +160,24 @@ namespace
             if (neiPyrVol[facei] < -SMALL) invalid[mesh.faceNeighbour()[facei]] = true;
         }
         return returnReduce(label(std::count(invalid.begin(), invalid.end(), true)), sumOp<label>());
+    }
+}
+
+
+TEST_CASE("An affine motion of the walls moves every point by exactly that motion", "[foam][bsplineMorph][rbf]")
+{
+    // multilevelBSpline's affine start (the default) reproduces it, the
+    // levels have nothing left to fit; RBF's linear polynomial reproduces it
+    // to the solves' round-off
+    SECTION("multilevelBSpline")
+    {
+        autoPtr<motionSolver> solver = bsplineSolver("");
+        requireAffine(solver.ref(), 1e-13);
+    }
+    SECTION("RBF")
+    {
+        autoPtr<motionSolver> solver = solverOf("RBF", "");
+        requireAffine(solver.ref(), 1e-10);
     }
 }
 
