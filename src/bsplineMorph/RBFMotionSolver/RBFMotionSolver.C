@@ -76,7 +76,7 @@ namespace Foam
 
             //- Fit each direction's values, evaluate at the evaluation
             //  points
-            virtual std::string interpolate
+            virtual interpolationReport interpolate
             (
                 const boundaryConstraints& bc,
                 std::vector<double>& result
@@ -126,7 +126,7 @@ Foam::rbfInterpolator<D>::rbfInterpolator
 
 
 template<int D>
-std::string Foam::rbfInterpolator<D>::interpolate
+Foam::interpolationReport Foam::rbfInterpolator<D>::interpolate
 (
     const boundaryConstraints& bc,
     std::vector<double>& result
@@ -160,7 +160,12 @@ std::string Foam::rbfInterpolator<D>::interpolate
     OStringStream os;
     os  << D << " systems of size up to " << size
         << ", reciprocal condition " << rcond;
-    return os.str();
+    interpolationReport report;
+    report.summary = os.str();
+    report.add("systems", D);
+    report.add("largestSystem", size);
+    report.add("reciprocalCondition", rcond);
+    return report;
 }
 
 

@@ -20,6 +20,8 @@ License
 #include "Enum.H"
 #include "mapPolyMesh.H"
 #include "OStringStream.H"
+#include "OFstream.H"
+#include "OSspecific.H"
 #include "coeffsInput.H"
 #include "setSizeOnHugePages.H"
 
@@ -53,7 +55,8 @@ namespace Foam
 
 Foam::scalar Foam::interpolatingMotionSolver::checkCells
 (
-    const pointField& points
+    const pointField& points,
+    label& nInvalid
 )
 {
     const clockTime timer;
@@ -62,6 +65,7 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
         checkPtr_.reset(new invertedCellCheck(mesh()));
     }
     const invertedCellCheck::result r = checkPtr_->check(points);
+    nInvalid = r.nInvalid;
     if (r.nInvalid == 0)
     {
         return timer.elapsedTime();
@@ -114,14 +118,14 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
 }
 
 
-std::string Foam::interpolatingMotionSolver::interpolateInto
+Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateInto
 (
     boundaryInterpolator& interpolator,
     const boundaryConstraints& bc,
     vectorField& displacement
 )
 {
-    const std::string summary = interpolator.interpolate(bc, values_);
+    const interpolationReport report = interpolator.interpolate(bc, values_);
     // The interpolated points' displacement (zero outside the solution
     // directions) and their moved points, in one pass
     // (each component read from its packed value or zero, into registers:
@@ -148,7 +152,7 @@ std::string Foam::interpolatingMotionSolver::interpolateInto
         displacement[pointi] = d;
         newPoints_[pointi] = p0[pointi] + d;
     }
-    return summary;
+    return report;
 }
 
 
@@ -278,7 +282,7 @@ bool Foam::interpolatingMotionSolver::updateControls()
 }
 
 
-std::string Foam::interpolatingMotionSolver::interpolateField
+Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
 (
     vectorField& displacement,
     const bool changed
@@ -286,7 +290,7 @@ std::string Foam::interpolatingMotionSolver::interpolateField
 {
     boundaryConstraints& bc = *constraintsPtr_;
     plan(interpolatorPtr_, bc, false, changed);
-    std::string summary = interpolateInto(*interpolatorPtr_, bc, displacement);
+    interpolationReport report = interpolateInto(*interpolatorPtr_, bc, displacement);
 
     // Sliding planes not along the axes: project; cyclic couplings: the
     // joined points' mean. Then fit again with those points as control
@@ -304,11 +308,17 @@ std::string Foam::interpolatingMotionSolver::interpolateField
          || !refit->sameControls(refitPtr_->controlPoints(), refitPtr_->mask());
         refitPtr_ = std::move(refit);
         plan(refitInterpolatorPtr_, *refitPtr_, true, refitChanged);
-        summary +=
+        const interpolationReport refitReport =
+            interpolateInto(*refitInterpolatorPtr_, *refitPtr_, displacement);
+        report.summary +=
             bc.nCyclicGlobal() > 0
           ? "; re-fit with the projected sliding and cyclic points: "
           : "; re-fit with the projected sliding points: ";
-        summary += interpolateInto(*refitInterpolatorPtr_, *refitPtr_, displacement);
+        report.summary += refitReport.summary;
+        for (const auto& figure : refitReport.figures)
+        {
+            report.add("refit_" + figure.first, figure.second);
+        }
     }
 
     // The layers near the listed walls move with them (from the walls'
@@ -325,7 +335,7 @@ std::string Foam::interpolatingMotionSolver::interpolateField
             newPoints_
         );
     }
-    return summary;
+    return report;
 }
 
 
@@ -383,7 +393,7 @@ void Foam::interpolatingMotionSolver::solve()
     // also zeroes the directions a 2D mesh does not solve for
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
     setSizeOnHugePages(newPoints_, points0().size());
-    std::string summary;
+    interpolationReport report;
     if (constraintsPtr_->nControlGlobal() == 0)
     {
         WarningInFunction
@@ -395,17 +405,63 @@ void Foam::interpolatingMotionSolver::solve()
     }
     else
     {
-        summary = interpolateField(displacement, changed);
+        report = interpolateField(displacement, changed);
     }
     moveBoundaryPoints(displacement);
-    const scalar checkSeconds = checkCells(newPoints_);
+    label nInvalid = 0;
+    const scalar checkSeconds = checkCells(newPoints_, nInvalid);
     correctBoundaryValues(displacement);
 
-    if (!summary.empty())
+    if (!report.summary.empty())
     {
-        Info<< type() << ": " << summary.c_str() << ", inverted-cell check "
-            << checkSeconds << " s, " << timer.elapsedTime() << " s" << endl;
+        const scalar seconds = timer.elapsedTime();
+        Info<< type() << ": " << report.summary.c_str() << ", inverted-cell check "
+            << checkSeconds << " s, " << seconds << " s" << endl;
+        report.add("invalidCells", nInvalid);
+        report.add("check_s", checkSeconds);
+        report.add("solve_s", seconds);
+        writeTable(report);
     }
+}
+
+
+void Foam::interpolatingMotionSolver::writeTable
+(
+    const interpolationReport& report
+)
+{
+    if (!Pstream::master())
+    {
+        return;
+    }
+    const Time& runTime = mesh().time();
+    if (!tablePtr_)
+    {
+        const fileName dir =
+            runTime.globalPath()/"postProcessing"/type()
+           /runTime.timeName(runTime.startTime().value());
+        mkDir(dir);
+        tablePtr_.reset(new OFstream(dir/(type() + ".dat")));
+        tablePtr_().precision(10);
+        tableColumns_.clear();
+    }
+    OFstream& os = tablePtr_();
+    // (a header whenever the columns change: a re-fit set that appears)
+    wordList columns(report.figures.size());
+    forAll(columns, i)
+    {
+        columns[i] = report.figures[i].first;
+    }
+    if (columns != tableColumns_)
+    {
+        os  << "# Time";
+        for (const word& c : columns) os << tab << c;
+        os  << nl;
+        tableColumns_ = columns;
+    }
+    os  << runTime.timeName();
+    for (const auto& figure : report.figures) os << tab << figure.second;
+    os  << endl;
 }
 
 

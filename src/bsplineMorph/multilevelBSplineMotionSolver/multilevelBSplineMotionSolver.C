@@ -103,7 +103,7 @@ namespace Foam
             {}
 
             //- Fit the control values, evaluate at the evaluation points
-            virtual std::string interpolate
+            virtual interpolationReport interpolate
             (
                 const boundaryConstraints& bc,
                 std::vector<double>& values
@@ -116,7 +116,7 @@ namespace Foam
 // * * * * * * * * * * * * * Local Member Functions  * * * * * * * * * * * * //
 
 template<int D>
-std::string Foam::bsplineInterpolator<D>::interpolate
+Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
 (
     const boundaryConstraints& bc,
     std::vector<double>& values
@@ -172,7 +172,22 @@ std::string Foam::bsplineInterpolator<D>::interpolate
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
         << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
         << r.seconds << " s, evaluation " << evalSeconds << " s";
-    return os.str();
+    interpolationReport report;
+    report.summary = os.str();
+    report.add("levels", r.levels);
+    report.add("separatedLevels", separated);
+    report.add("maxResidual", r.maxResidual);
+    report.add("threshold", r.threshold);
+    report.add("converged", r.converged);
+    report.add("latticeNodes", nodes);
+    report.add("planMB", planMB);
+    report.add("bytes", bytes);
+    report.add("bytesOneRank", bytesMax);
+    report.add("messages", messages);
+    report.add("messagesOneRank", messagesMax);
+    report.add("fit_s", r.seconds);
+    report.add("evaluation_s", evalSeconds);
+    return report;
 }
 
 
