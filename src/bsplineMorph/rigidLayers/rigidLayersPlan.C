@@ -1,0 +1,334 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "rigidLayers.H"
+#include "emptyPolyPatch.H"
+#include "syncTools.H"
+#include "globalIndex.H"
+#include "bitSet.H"
+#include "PstreamBuffers.H"
+#include "indexedOctree.H"
+#include "treeDataPoint.H"
+
+#include <algorithm>
+#include <vector>
+
+// The plan of the rigid layers, once per topology: the walls' points, each
+// zone point's foot (the nearest wall point, also on nearby ranks), the
+// zone's outermost points
+
+// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
+
+namespace Foam
+{
+namespace
+{
+    //- Squared distance from a point to a box (0 inside; large for an
+    //  empty box)
+    scalar distSqrToBox(const point& p, const boundBox& bb)
+    {
+        if (bb.empty())
+        {
+            return GREAT;
+        }
+        scalar s = 0;
+        for (direction d = 0; d < 3; ++d)
+        {
+            const scalar below = bb.min()[d] - p[d];
+            const scalar above = p[d] - bb.max()[d];
+            const scalar out = max(below, above);
+            if (out > 0)
+            {
+                s += out*out;
+            }
+        }
+        return s;
+    }
+
+    //- Whether foot a is preferred to foot b at the same squared distance:
+    //  the lexicographically smaller point, then a copy on this rank (the
+    //  same point on two ranks has the same transform)
+    template<class Candidate>
+    bool preferred(const Candidate& a, const Candidate& b)
+    {
+        for (direction d = 0; d < 3; ++d)
+        {
+            if (a.x[d] != b.x[d])
+            {
+                return a.x[d] < b.x[d];
+            }
+        }
+        return a.local && !b.local;
+    }
+}
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::rigidLayers::findWallPoints()
+{
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    // The wall points, and where each listed patch's points are among them
+    bitSet onWall(mesh_.nPoints());
+    for (const label patchi : patchIDs_)
+    {
+        onWall.set(pbm[patchi].meshPoints());
+    }
+    wallPoints_ = onWall.sortedToc();
+    Map<label> wallOf(2*wallPoints_.size());
+    forAll(wallPoints_, i)
+    {
+        wallOf.insert(wallPoints_[i], i);
+    }
+    // The smoothing of the rotations: as many rings of faces as make
+    // innerDistance (by the walls' mean edge length)
+    scalar edgeSum = 0;
+    label nEdges = 0;
+    for (const label patchi : patchIDs_)
+    {
+        for (const edge& e : pbm[patchi].edges())
+        {
+            edgeSum += e.mag(pbm[patchi].localPoints());
+            ++nEdges;
+        }
+    }
+    edgeSum = returnReduce(edgeSum, sumOp<scalar>());
+    nEdges = returnReduce(nEdges, sumOp<label>());
+    nSmooth_ = nEdges && edgeSum > 0
+      ? min(label(std::ceil(innerDistance_*nEdges/edgeSum)), label(50)) : 0;
+
+    patchWall_.setSize(patchIDs_.size());
+    forAll(patchIDs_, k)
+    {
+        const labelList& meshPoints = pbm[patchIDs_[k]].meshPoints();
+        patchWall_[k].setSize(meshPoints.size());
+        forAll(meshPoints, i)
+        {
+            patchWall_[k][i] = wallOf[meshPoints[i]];
+        }
+    }
+}
+
+
+std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
+(
+    const pointField& points0,
+    const globalIndex& wallIndex
+) const
+{
+    const label myProc = Pstream::myProcNo();
+    // Candidate feet: this rank's wall points and those of the other ranks
+    // within outerDistance of this rank's points
+    const scalar outer = outerDistance_;
+    List<boundBox> rankBox(Pstream::nProcs());
+    rankBox[myProc] = boundBox(points0, false);
+    Pstream::gatherList(rankBox);
+    Pstream::scatterList(rankBox);
+
+    std::vector<footCandidate> cand;
+    cand.reserve(wallPoints_.size());
+    forAll(wallPoints_, i)
+    {
+        cand.push_back({wallIndex.toGlobal(i), points0[wallPoints_[i]], true});
+    }
+    if (Pstream::parRun())
+    {
+        PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
+        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
+        {
+            if (proci == myProc)
+            {
+                continue;
+            }
+            DynamicList<label> ids;
+            DynamicList<point> xs;
+            forAll(wallPoints_, i)
+            {
+                const point& x = points0[wallPoints_[i]];
+                if (distSqrToBox(x, rankBox[proci]) <= outer*outer)
+                {
+                    ids.append(wallIndex.toGlobal(i));
+                    xs.append(x);
+                }
+            }
+            UOPstream os(proci, buffers);
+            os << ids << xs;
+        }
+        buffers.finishedSends();
+        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
+        {
+            if (proci == myProc)
+            {
+                continue;
+            }
+            UIPstream is(proci, buffers);
+            labelList ids;
+            List<point> xs;
+            is >> ids >> xs;
+            forAll(ids, i)
+            {
+                cand.push_back({ids[i], xs[i], false});
+            }
+        }
+    }
+
+    return cand;
+}
+
+
+void Foam::rigidLayers::findFeet
+(
+    const pointField& points0,
+    const std::vector<footCandidate>& cand
+)
+{
+    // The candidates in an octree: each point's nearest one within
+    // outerDistance, then every candidate at exactly that distance (ties go
+    // to preferred())
+    zonePoints_.clear();
+    zoneFoot_.clear();
+    zoneWeight_.clear();
+    zoneArm_.clear();
+    if (cand.empty())
+    {
+        return;
+    }
+    pointField candPoints(label(cand.size()));
+    forAll(candPoints, c)
+    {
+        candPoints[c] = cand[c].x;
+    }
+    const treeBoundBox candBox(candPoints);
+    const treeDataPoint shapes(candPoints);
+    const indexedOctree<treeDataPoint> tree
+    (
+        shapes,
+        treeBoundBox(candBox.min() - vector::one*outerDistance_, candBox.max() + vector::one*outerDistance_),
+        10,     // levels
+        10,     // candidates per leaf
+        3       // duplicity
+    );
+
+    DynamicList<label> zone, feet;
+    DynamicList<scalar> weights;
+    DynamicList<vector> arms;
+    const scalar outerSqr = sqr(outerDistance_);
+    forAll(points0, pointi)
+    {
+        const point& x = points0[pointi];
+        if (distSqrToBox(x, candBox) >= outerSqr)
+        {
+            continue;   // (most points of a large mesh: no search)
+        }
+        const pointIndexHit hit = tree.findNearest(x, outerSqr);
+        if (!hit.hit())
+        {
+            continue;
+        }
+        label best = hit.index();
+        const scalar bestSqr = magSqr(x - cand[best].x);
+        for (const label c : tree.findSphere(x, bestSqr))
+        {
+            if (magSqr(x - cand[c].x) == bestSqr && preferred(cand[c], cand[best]))
+            {
+                best = c;
+            }
+        }
+        zone.append(pointi);
+        feet.append(cand[best].globalIndex);
+        weights.append(weight(std::sqrt(bestSqr), innerDistance_, outerDistance_));
+        arms.append(x - cand[best].x);
+    }
+    zonePoints_.transfer(zone);
+    zoneFoot_.transfer(feet);
+    zoneWeight_.transfer(weights);
+    zoneArm_.transfer(arms);
+}
+
+
+void Foam::rigidLayers::findOutermost()
+{
+    // The rigid zone's outermost points off the patches (within
+    // innerDistance, with an edge to a point beyond it): the interpolation's
+    // extra control points
+    boolList inner(mesh_.nPoints(), false);
+    forAll(zonePoints_, i)
+    {
+        inner[zonePoints_[i]] = zoneWeight_[i] == 1;
+    }
+    labelList outermost(mesh_.nPoints(), 0);
+    for (const edge& e : mesh_.edges())
+    {
+        if (inner[e.first()] != inner[e.second()])
+        {
+            outermost[inner[e.first()] ? e.first() : e.second()] = 1;
+        }
+    }
+    syncTools::syncPointList(mesh_, outermost, maxEqOp<label>(), label(0));
+    bitSet onPatch(mesh_.nPoints());
+    for (const polyPatch& pp : mesh_.boundaryMesh())
+    {
+        if (!pp.coupled() && !isA<emptyPolyPatch>(pp))
+        {
+            onPatch.set(pp.meshPoints());
+        }
+    }
+    DynamicList<label> shell, shellPoints;
+    forAll(zonePoints_, i)
+    {
+        const label pointi = zonePoints_[i];
+        if (inner[pointi] && outermost[pointi] && !onPatch.test(pointi))
+        {
+            shell.append(i);
+            shellPoints.append(pointi);
+        }
+    }
+    shell_.transfer(shell);
+    shellPoints_.transfer(shellPoints);
+
+}
+
+
+void Foam::rigidLayers::plan(const pointField& points0)
+{
+    findWallPoints();
+    const globalIndex wallIndex(wallPoints_.size());
+    findFeet(points0, footCandidates(points0, wallIndex));
+    findOutermost();
+    // The feet in compact numbering: this rank's wall points, then the other
+    // ranks' that are feet here
+    List<Map<label>> compactMap;
+    mapPtr_.reset(new mapDistribute(wallIndex, zoneFoot_, compactMap));
+    planned_ = true;
+
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    const wordList patchNames(pbm.names(), patchIDs_);
+    const label nInner = std::count(zoneWeight_.begin(), zoneWeight_.end(), scalar(1));
+    Info<< "rigidLayers: " << returnReduce(zonePoints_.size(), sumOp<label>())
+        << " points within outerDistance " << outerDistance_ << " of "
+        << returnReduce(wallPoints_.size(), sumOp<label>()) << " wall points on patches "
+        << flatOutput(patchNames)
+        << " (" << returnReduce(nInner, sumOp<label>())
+        << " within innerDistance " << innerDistance_ << ", "
+        << returnReduce(shellPoints_.size(), sumOp<label>())
+        << " of them outermost: control points; rotations smoothed over "
+        << nSmooth_ << " rings of faces)" << endl;
+}
+
+
+// ************************************************************************* //
