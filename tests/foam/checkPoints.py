@@ -13,26 +13,19 @@
     checkPoints.py cyclic CASE box|sector    the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
                                              the box's x faces, the sector's sides) have displacements
                                              equal through the pair's transform at every written time
+    checkPoints.py tiltedSlip CASE           the sheared block of tests/foam/Alltest.d/tiltedSlip at
+                                             time 1: the walls' points on their tilted planes, the
+                                             first cell layer following the wall, the pushed face
 
-Exit status 1 on any failed check; prints what it measured. Other test scripts
-import it for readPoints, readLabels, pointsAt and check (run from the project's
-top folder: sys.path.insert(0, "tests/foam")).
+Exit status 1 on any failed check; prints what it measured. Other test
+scripts import check and failures from it (tests/foam/checkMorphQuality.py).
+The points are read by bin/bsmdata.py (readPoints, readLabels, pointsAt,
+comparePoints; also importable from here, as before).
 """
-import re, sys
-
-def readPoints(path):
-    txt = open(path).read()
-    body = txt[txt.index("(", txt.index("}")) :]
-    nums = re.findall(r"\(([^()]+)\)", body)
-    return [tuple(float(v) for v in s.split()) for s in nums]
-
-def readLabels(path):
-    """An ascii labelList (e.g. decomposePar's pointProcAddressing)"""
-    txt = open(path).read()
-    return [int(v) for v in txt[txt.index("(", txt.index("}")) + 1:txt.rindex(")")].split()]
-
-def pointsAt(case, time):
-    return readPoints("%s/%s/polyMesh/points" % (case, time) if time != "constant" else "%s/constant/polyMesh/points" % case)
+import os, sys
+sys.dont_write_bytecode = True     # (no __pycache__ in the source tree)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bin"))
+from bsmdata import readPoints, readLabels, pointsAt, comparePoints
 
 failures = []
 def check(cond, msg):
@@ -41,7 +34,6 @@ def check(cond, msg):
         failures.append(msg)
 
 def cyclicPairs(case, kind):
-    import os
     p0 = pointsAt(case, "constant")
     if kind == "box":      # left (x = 0) -> right (x = 1): translate by (1 0 0)
         onA = lambda p: abs(p[0]) < 1e-9
@@ -72,17 +64,49 @@ def cyclicPairs(case, kind):
               % (t, diff, moved))
         check(moved > 1e-4, "time %s: the cyclic points moved (largest %.3g), the check is not vacuous" % (t, moved))
 
+def tiltedSlip(case):
+    """tests/foam/Alltest.d/tiltedSlip: a block sheared so that its bottom and
+    top are the planes z = 0.5 x and z = 1 + 0.5 x (slip walls), its left face
+    pushed 0.1 along x, its right face fixed; time 1"""
+    import math
+    p0, p1 = pointsAt(case, "constant"), pointsAt(case, 1)
+    n = (-0.5 / math.hypot(0.5, 1), 0.0, 1 / math.hypot(0.5, 1))
+    # wall points stay on their planes (but those of the fixed faces, which win)
+    off = max(abs(b[2] - 0.5 * b[0] - (1 if a[2] - 0.5 * a[0] > 0.5 else 0))
+              for a, b in zip(p0, p1)
+              if 0 < a[0] < 1 and (abs(a[2] - 0.5 * a[0]) < 1e-9 or abs(a[2] - 0.5 * a[0] - 1) < 1e-9))
+    check(off < 1e-12, "bottom and top wall points stay on their planes (largest distance %.2e)" % off)
+    # the first layer above the bottom wall follows it: its displacement normal
+    # to the wall, relative to the wall point below. The pushed face's motion has
+    # the normal component 0.1 (1 - x) |n_x| = 0.0447 (1 - x); projecting only the
+    # wall points would leave all of it in the first layer. Mid-channel
+    # (0.3 <= x <= 0.7, away from the pushed and the fixed face) at most 30% of
+    # that may remain.
+    key = lambda a: (round(a[0], 9), round(a[1], 9), round(a[2] - 0.5 * a[0], 9))
+    index = {key(a): i for i, a in enumerate(p0)}
+    prof = {}
+    for i, a in enumerate(p0):
+        x, y, h = key(a)
+        if h == 0 and 0 < x < 1:
+            j = index[(x, y, 0.1)]
+            dd = [(p1[j][k] - p0[j][k]) - (p1[i][k] - a[k]) for k in range(3)]
+            prof[x] = max(prof.get(x, 0.0), abs(sum(dd[k] * n[k] for k in range(3))))
+    print("     first-layer normal displacement relative to the wall, by x: "
+          + " ".join("%g:%.4f" % (x, v) for x, v in sorted(prof.items())))
+    ratio = max(v / (0.1 * abs(n[0]) * (1 - x)) for x, v in prof.items() if 0.3 - 1e-9 <= x <= 0.7 + 1e-9)
+    check(ratio < 0.3, "mid-channel first layer keeps %.0f%% of the normal motion projection alone would leave (< 30%%)" % (100 * ratio))
+    moved = max(abs(b[0] - a[0]) for a, b in zip(p0, p1))
+    check(abs(moved - 0.1) < 1e-12, "the left face moved 0.1 (largest x displacement %.3g)" % moved)
+
 def main():
     mode = sys.argv[1]
     if mode == "equal":
         a, b, time = sys.argv[2:5]
         tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
-        pa, pb = pointsAt(a, time), pointsAt(b, time)
-        check(len(pa) == len(pb), "same number of points (%d, %d)" % (len(pa), len(pb)))
-        p0 = pointsAt(a, "constant")
-        size = max(max(p[d] for p in p0) - min(p[d] for p in p0) for d in range(3))
-        diff = max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
-        check(diff <= tol*size, "largest difference %.3e <= %.1e x domain size %.3g" % (diff, tol, size))
+        c = comparePoints(a, b, time)
+        check(c["nA"] == c["nB"], "same number of points (%d, %d)" % (c["nA"], c["nB"]))
+        check(c["diff"] <= tol*c["size"], "largest difference %.3e <= %.1e x domain size %.3g"
+              % (c["diff"], tol, c["size"]))
     elif mode == "at":
         case, time = sys.argv[2:4]
         x0, x1 = [float(v) for v in sys.argv[4:7]], [float(v) for v in sys.argv[7:10]]
@@ -136,6 +160,8 @@ def main():
             check(zErr == 0.0, "empty-direction coordinates unchanged exactly (largest change %.3e)" % zErr)
     elif mode == "cyclic":
         cyclicPairs(sys.argv[2], sys.argv[3])
+    elif mode == "tiltedSlip":
+        tiltedSlip(sys.argv[2])
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv
