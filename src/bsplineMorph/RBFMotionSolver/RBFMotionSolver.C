@@ -175,7 +175,7 @@ void Foam::RBFMotionSolver::readCoeffs()
 {
     const dictionary& dict = coeffDict();
     params_.function =
-        kernelNames.lookupOrDefault("function", dict, rbf::kernel::inverseMultiquadric);
+        kernelNames.lookupOrDefault("function", dict, rbf::kernel::thinPlateSpline);
     params_.shapeParameter =
         coeffsInput::getInRange<scalar>(dict, "shapeParameter", 0.05, SMALL);
     params_.supportRadius =
@@ -261,7 +261,16 @@ Foam::RBFMotionSolver::newInterpolator
     catch (const std::exception& e)
     {
         FatalErrorInFunction
-            << "Cannot set up the RBF systems: " << e.what() << exit(FatalError);
+            << "Cannot set up the RBF systems: " << e.what()
+            << (
+                   params_.function == rbf::kernel::thinPlateSpline
+                 ? ""
+                 : ". The default function thinPlateSpline has no shape"
+                   " parameter and solved on every case measured (README,"
+                   " The RBF baseline); or lower shapeParameter /"
+                   " supportRadius"
+               )
+            << exit(FatalError);
     }
     Info<< type() << ": " << kernelNames[params_.function] << " systems for "
         << bc.nControlGlobal() << " control points factored in "
