@@ -14,25 +14,27 @@
 // stencil weights w (4^D nodes) proposes phi_c = w r_c / sum(w^2) to its nodes;
 // each node keeps delta = sum w^2 phi_c and omega = sum w^2 and phi = delta/omega.
 // delta and omega are sums, so partial sums from different ranks add. Each rank
-// holds its own partial sums ("own" tiles), clusters them into buckets whose
-// index boxes are all-gathered (a small directory of who holds what). Each rank
-// then asks the owners of the buckets that meet the stencils of its own query
-// points (its control and evaluation points) for exactly the tiles those
-// stencils touch, receives their partial sums point to point and adds them in
-// rank order, so every rank that sees a node gets bitwise the same phi there.
-// At fine levels the owner's control points that touch the asked tiles are
-// fewer than the tiles' nodes: the owner then sends their coordinates once and
-// their residuals per fit ("ghosts"), and the asking rank computes the owner's
-// partial sums itself, with the same points in the same order (bitwise equal).
+// holds its own partial sums ("own" tiles) and receives, from the ranks that
+// hold partial sums on the tiles its own points' stencils touch, exactly those
+// tiles (or the residuals of the few points behind them), adding them in rank
+// order, so every rank that sees a node gets bitwise the same phi there.
+//
+// This header is the interface; the parts live in internal headers:
+// pointSets.hpp and spatialOrder.hpp (the points in spatial order),
+// levelPlan.hpp (a level's plan: tiles, buckets, requests, ghosts, the
+// separation test), levelApply.hpp (a level's apply in every fit),
+// flatEvaluator.hpp with subdivision.hpp and plainLattice.hpp (evaluation),
+// lattice.hpp and stencilKernels.hpp (tiled lattices and their kernels).
 #ifndef MBA_MULTILEVEL_HPP
 #define MBA_MULTILEVEL_HPP
 
-#include "affine.hpp"
 #include "communicator.hpp"
-#include "hugePages.hpp"
-#include "lattice.hpp"
+#include "geometry.hpp"
+#include "vectorWidth.hpp"
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace mba {
 
@@ -98,71 +100,10 @@ struct fitReport
 template <int D>
 class multilevel
 {
-    struct level;
-
-    const communicator& comm_;
-    params p_;
-    int nc_, nw_;                       ///< components; omega values per node (1 or nc)
-    pointsView<D> ctrl_, eval_;
-    std::vector<std::uint8_t> mask_;    ///< per control point x component, empty: all
-    std::vector<std::uint8_t> active_;  ///< control point constrains something
-    domain<D> dom_;
-    affineFit<D> affine_;
-    std::vector<box<D>> queryBoxes_;    ///< clusters of this rank's control and evaluation points
-    std::vector<std::vector<const double*>> queryGroups_; ///< the points of each cluster
-    std::vector<std::uint32_t> ctrlOrder_; ///< active control points in space-filling-curve order
-    std::vector<std::uint32_t> evalOrder_; ///< evaluation points in curve order (empty: their own order)
-    std::size_t evalAt(std::size_t q) const { return evalOrder_.empty() ? q : evalOrder_[q]; }
-    std::vector<point<D>> ctrlU0_;      ///< level-0 local coordinates of the active control points, in ctrlOrder_
-    hugeVector<point<D>> evalU0_;       ///< the same of the evaluation points, in evalOrder_
-    std::vector<stencil<D>> stencils_;  ///< a fit's control-point stencils at the current level
-    std::vector<stencil<D>> cubed_;     ///< the same with their weights cubed (for the scatter)
-    std::vector<std::uint32_t> evalPos_; ///< position of each evaluation point in evalOrder_ (curve order only)
-    mutable hugeVector<double> sweep_;  ///< evaluate()'s values in curve order (kept: no new pages per call)
-    std::vector<std::unique_ptr<level>> levels_;
-    std::vector<double> residual_, scratch_;
-    std::vector<double> rr_;            ///< a fit's r/sum(w^2) per control point x component at the current level
-    std::vector<double> atCtrl_;        ///< the current level's values at the control points (in ctrlOrder_)
-    /// Levels 0..flat_ refined (B-spline subdivision: exact) and summed, with
-    /// the affine approximation (reproduced exactly by its node values), into
-    /// one plain, untiled lattice over the level-flat_ nodes that the planned
-    /// evaluation points' stencils touch (flatBox_), so that most points cost
-    /// one contiguous stencil; flat_ is the finest level whose box has at most
-    /// as many nodes as there are evaluation points (-1: none)
-    int flat_ = -1;
-    point<D> evalLo0_, evalHi0_;        ///< level-0 local box of the evaluation points
-    indexBox<D> flatBox_;
-    hugeVector<double> flatPhi_, foldScratch_;
-    /// The evaluation points (positions in evalOrder_, ascending) where levels
-    /// above flat_ have coefficients at the point's stencil (a node with
-    /// omega > 0; phi is 0 at the others), and those levels: bit j for level
-    /// flat_ + 1 + j
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> deepLevels_;
-    /// Their stencils' tiles, point after point in evalOrder_
-    std::vector<stencilTiles<D>> deepTiles_;
-    std::pair<int, int> deepKey_{-1, -1}; ///< (levels built, flat_) deepLevels_ was found for
-    fitReport report_;
-    std::int64_t nCtrlGlobal_ = 0;
-
-    void buildLevel(int k);
-    void applyLevel(level& L);
-    template <class F> void forOwnStencils(const level& L, F&& f) const;
-    /// The stencil of control point ctrlOrder_[q] at level L
-    stencil<D> ctrlStencil(const level& L, std::size_t q) const;
-    void residualStats(double& maxr, double& rms) const;
-    void addLevels(const double* x, double* out, int nLevels) const;
-    void fold();
-    indexBox<D> evalNodeBox(int k) const;
-    /// Stores the coefficients that separated levels leave out per fit (level::readEveryFit)
-    void completeLattices() const;
-    /// The components control point i constrains, in on[0..nc): on, or
-    /// nullptr when every active point constrains all (one omega per node)
-    const bool* constrained(std::size_t i, bool* on) const
-    {
-        if (nw_ == 1) return nullptr;
-        for (int c = 0; c < nc_; ++c) on[c] = mask_[i*nc_ + c] != 0;
-        return on;
-    }
+    struct state;                   ///< the plan, the levels and the work arrays (multilevel.cpp)
+    std::unique_ptr<state> state_;
+    state& self() { return *state_; }
+    const state& self() const { return *state_; }   ///< (const members see the state const)
 
 public:
     /// The plan. control, evaluation: this rank's points (not copied: they must
@@ -182,6 +123,9 @@ public:
     /// ignored). Collective. Repeated fits reuse the plan.
     const fitReport& fit(const std::vector<double>& values);
 
+    // The evaluations are const but fill caches (the coefficients a fit
+    // leaves for later, a scratch array): one thread at a time per object.
+
     /// The approximation at the planned evaluation points (point x component)
     void evaluate(std::vector<double>& out) const;
 
@@ -193,14 +137,14 @@ public:
     /// The approximation at this rank's control points (point x component)
     void evaluateControl(std::vector<double>& out) const;
 
-    const domain<D>& dom() const { return dom_; }
-    const fitReport& report() const { return report_; }
+    const domain<D>& dom() const;
+    const fitReport& report() const;
     std::vector<levelStats> stats() const;
     /// Bytes held by the plan (levels and work arrays)
     std::int64_t bytes() const;
     /// Bytes each rank would receive if it gathered every control point instead
     std::int64_t gatherAllBytes() const;
-    int nComponents() const { return nc_; }
+    int nComponents() const;
 };
 
 } // namespace mba

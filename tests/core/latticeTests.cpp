@@ -1,5 +1,5 @@
 #include <catch2/catch.hpp>
-#include "lattice.hpp"
+#include "stencilKernels.hpp"
 #include "testData.hpp"
 
 #include <cmath>

@@ -2,6 +2,7 @@
 #ifndef BSM_TEST_DATA_HPP
 #define BSM_TEST_DATA_HPP
 
+#include "lattice.hpp"
 #include "multilevel.hpp"
 
 #include <cmath>

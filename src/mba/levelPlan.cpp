@@ -1,0 +1,468 @@
+// The query clusters, then the planning of a level in the steps that
+// levelPlanner::run() takes in order.
+#include "levelPlan.hpp"
+#include "buckets.hpp"
+#include "collectively.hpp"
+#include "stencilKernels.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mba {
+
+template <int D>
+queryClusters<D> clusterQueryPoints(const communicator& comm, const controlPoints<D>& ctrl, pointsView<D> eval)
+{
+    queryClusters<D> clusters;
+    if (comm.size() == 1) return clusters;
+    std::vector<const double*> q;
+    for (std::size_t i = 0; i < ctrl.x.size; ++i) if (ctrl.active[i]) q.push_back(ctrl.x[i]);
+    for (std::size_t i = 0; i < eval.size; ++i) q.push_back(eval[i]);
+    const std::int64_t leaf = std::max<std::int64_t>(64, std::int64_t(q.size())/512);
+    const auto groups = bisect<D>(std::int64_t(q.size()), [&](std::int64_t i) {
+        point<D> x;
+        for (int d = 0; d < D; ++d) x[d] = q[i][d];
+        return x;
+    }, leaf);
+    for (const auto& g : groups)
+    {
+        box<D> qb = box<D>::empty();
+        std::vector<const double*> members;
+        for (auto i : g) { qb.add(q[i]); members.push_back(q[i]); }
+        clusters.boxes.push_back(qb);
+        clusters.points.push_back(std::move(members));
+    }
+    return clusters;
+}
+
+namespace {
+
+/// An empty index box that any box's add makes that box
+template <int D>
+indexBox<D> emptyIndexBox()
+{
+    indexBox<D> b;
+    b.lo.fill(INT64_MAX);
+    b.hi.fill(INT64_MIN);
+    return b;
+}
+
+/// The planning of one level, step after step (run() in order)
+template <int D>
+class levelPlanner
+{
+    static constexpr int npt = levelPlan<D>::npt;
+
+    const communicator& comm_;          ///< the ranks
+    const domain<D>& dom_;              ///< the lattices' domain
+    const controlPoints<D>& ctrl_;      ///< this rank's control points
+    const queryClusters<D>& clusters_;  ///< this rank's query points (parallel only)
+    const int bucketTiles_;             ///< target tiles per bucket (params::bucketTiles)
+    const int nRanks_, me_;             ///< the communicator's size and this rank
+    const int nc_, omegaPerNode_;       ///< values a point, omega values a node (as ctrl_'s)
+
+    levelPlan<D> L_;                    ///< the plan being made
+    index<D> nodes_;                    ///< the level's nodes per direction
+    std::int64_t nOwn_ = 0;             ///< own tiles
+    std::vector<stencilTiles<D>> ownIds_; ///< the own points' stencil tiles in the own layout, in order
+    hugeVector<double> ownOmega_;       ///< this rank's partial omega on its own tiles (may become the view's)
+    std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
+    std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
+
+    void ownTilesAndOmega();
+    std::vector<std::vector<std::int64_t>> bucketDirectory();
+    std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
+    std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
+    void answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted);
+    void chooseGhosts();
+    void assembleView();
+    void sumOmega(const std::vector<std::int64_t>& ownToView);
+    void findControlTiles();
+    void testSeparation();
+    void findGhostTiles();
+    void fillStats();
+
+public:
+    levelPlanner(const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                 const queryClusters<D>& clusters, int bucketTiles)
+    :
+        comm_(comm), dom_(dom), ctrl_(ctrl), clusters_(clusters), bucketTiles_(bucketTiles),
+        nRanks_(comm.size()), me_(comm.rank()), nc_(ctrl.nComponents), omegaPerNode_(ctrl.omegaPerNode)
+    {}
+
+    levelPlan<D> run(int k);
+};
+
+template <int D>
+levelPlan<D> levelPlanner<D>::run(int k)
+{
+    L_.level = k;
+    L_.scale = std::ldexp(1.0, k);
+    for (int d = 0; d < D; ++d) nodes_[d] = dom_.nodes(k, d);
+    collectively(comm_, [&] { L_.ownLayout.init(nodes_, false); });
+    ownTilesAndOmega();
+    L_.tilesTo.assign(nRanks_, {});
+    L_.tilesFrom.assign(nRanks_, {});
+    keysFrom_.assign(nRanks_, {});
+    omegaFrom_.assign(nRanks_, {});
+    if (nRanks_ > 1)
+    {
+        answerRequests(comm_.exchange(tileRequests(bucketDirectory())));
+        chooseGhosts();
+    }
+    assembleView();
+    findControlTiles();
+    testSeparation();
+    for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
+    findGhostTiles();
+    L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
+    precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
+    if (L_.separated)
+    {
+        // every point's phi is stored until the evaluator has found the tiles read
+        L_.readEveryFit.assign(ctrl_.order.size(), 1);
+        L_.scaledResiduals.assign(ctrl_.order.size()*nc_, 0.0);
+    }
+    fillStats();
+    return std::move(L_);
+}
+
+/// This rank's tiles, the tiles of each control point's stencil (found once:
+/// for omega, the ghosts and the fits) and partial omega
+template <int D>
+void levelPlanner<D>::ownTilesAndOmega()
+{
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L_.ownLayout, st); });
+    nOwn_ = L_.ownLayout.size();
+    ownIds_.resize(ctrl_.order.size());
+    ownOmega_.assign(nOwn_*npt*omegaPerNode_, 0.0);
+    std::size_t pos = 0;
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
+        findTiles(L_.ownLayout, st, ownIds_[pos]);
+        detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
+            double* o = &ownOmega_[(id*npt + n)*omegaPerNode_];
+            if (omegaPerNode_ == 1) o[0] += w*w;
+            else for (int c = 0; c < omegaPerNode_; ++c) if (ctrl_.mask[i*nc_ + c]) o[c] += w*w;
+        });
+    });
+}
+
+/// Buckets of own tiles, their index boxes (lo, hi) all-gathered: per rank
+/// its buckets' boxes, 2D values each
+template <int D>
+std::vector<std::vector<std::int64_t>> levelPlanner<D>::bucketDirectory()
+{
+    const tileLayout<D>& own = L_.ownLayout;
+    const auto buckets = bisect<D>(nOwn_, [&](std::int64_t id) {
+        const index<D> t = own.coord(own.keyOf(id));
+        std::array<double, D> x;
+        for (int d = 0; d < D; ++d) x[d] = double(t[d]);
+        return x;
+    }, bucketTiles_);
+    std::vector<std::int64_t> myBoxes;
+    for (const auto& g : buckets)
+    {
+        indexBox<D> bb = emptyIndexBox<D>();
+        for (auto id : g)
+        {
+            const index<D> t = own.coord(own.keyOf(id));
+            for (int d = 0; d < D; ++d) { bb.lo[d] = std::min(bb.lo[d], t[d]); bb.hi[d] = std::max(bb.hi[d], t[d]); }
+        }
+        myBoxes.insert(myBoxes.end(), bb.lo.begin(), bb.lo.end());
+        myBoxes.insert(myBoxes.end(), bb.hi.begin(), bb.hi.end());
+    }
+    L_.stats.buckets = std::int64_t(buckets.size());
+    return comm_.allGather(myBoxes);
+}
+
+/// The query clusters' stencils at this level as tile boxes; all: their union
+template <int D>
+std::vector<indexBox<D>> levelPlanner<D>::clusterTileBoxes(indexBox<D>& all) const
+{
+    std::vector<indexBox<D>> qt;
+    all = emptyIndexBox<D>();
+    for (const auto& qb : clusters_.boxes)
+    {
+        const point<D> ulo = scaled<D>(dom_.local0(qb.lo.data()), L_.scale);
+        const point<D> uhi = scaled<D>(dom_.local0(qb.hi.data()), L_.scale);
+        indexBox<D> t;
+        for (int d = 0; d < D; ++d)
+        {
+            t.lo[d] = std::int64_t(std::floor(ulo[d]))/tileEdge;
+            t.hi[d] = (std::int64_t(std::floor(uhi[d])) + 3)/tileEdge;
+            all.lo[d] = std::min(all.lo[d], t.lo[d]);
+            all.hi[d] = std::max(all.hi[d], t.hi[d]);
+        }
+        qt.push_back(t);
+    }
+    return qt;
+}
+
+/// Per rank the keys of the tiles to ask it for: remote bucket boxes that
+/// meet a cluster's stencils, and in them exactly the tiles the cluster's
+/// point stencils touch
+template <int D>
+std::vector<std::vector<std::uint64_t>>
+levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const
+{
+    indexBox<D> all;
+    const std::vector<indexBox<D>> qt = clusterTileBoxes(all);
+    std::vector<indexBox<D>> remote;
+    std::vector<int> remoteRank;
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        if (r == me_ || qt.empty()) continue;
+        const auto& v = directory[r];
+        for (std::size_t b = 0; b < v.size()/(2*D); ++b)
+        {
+            indexBox<D> rb;
+            for (int d = 0; d < D; ++d) { rb.lo[d] = v[2*D*b + d]; rb.hi[d] = v[2*D*b + D + d]; }
+            if (rb.intersects(all)) { remote.push_back(rb); remoteRank.push_back(r); }
+        }
+    }
+    std::vector<std::vector<std::uint64_t>> requests(nRanks_);
+    std::vector<hashMap> requested(nRanks_);
+    std::vector<std::size_t> hits;
+    for (std::size_t g = 0; g < qt.size() && !remote.empty(); ++g)
+    {
+        hits.clear();
+        for (std::size_t b = 0; b < remote.size(); ++b) if (remote[b].intersects(qt[g])) hits.push_back(b);
+        if (hits.empty()) continue;
+        for (const double* x : clusters_.points[g])
+        {
+            const point<D> u = scaled<D>(dom_.local0(x), L_.scale);
+            forEachIndex<D>(stencil<D>(u.data()).tiles(), [&](const index<D>& t) {
+                for (const std::size_t b : hits)
+                {
+                    if (!remote[b].contains(t)) continue;
+                    const int r = remoteRank[b];
+                    const std::uint64_t key = L_.ownLayout.key(t);
+                    const std::size_t before = requested[r].size();
+                    requested[r].insert(key, 0);
+                    if (requested[r].size() != before) requests[r].push_back(key);
+                }
+            });
+        }
+    }
+    return requests;
+}
+
+/// The own tiles other ranks asked for (wanted: per rank its keys): their
+/// ids (tilesTo, own ids for now), and their keys and partial omega sent
+template <int D>
+void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted)
+{
+    std::vector<std::vector<std::uint64_t>> keys(nRanks_);
+    std::vector<std::vector<double>> om(nRanks_);
+    const int blk = npt*omegaPerNode_;
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        for (const std::uint64_t key : wanted[r])
+        {
+            const std::int64_t id = L_.ownLayout.findKey(key);
+            if (id < 0) continue;
+            L_.tilesTo[r].push_back(id);
+            keys[r].push_back(key);
+            om[r].insert(om[r].end(), ownOmega_.begin() + id*blk, ownOmega_.begin() + (id + 1)*blk);
+        }
+    }
+    keysFrom_ = comm_.exchange(keys);
+    omegaFrom_ = comm_.exchange(om);
+}
+
+/// Ghost mode towards r when this rank's points that touch the tiles r
+/// asked for cost less per apply (nc values each) than the tiles (npt*nc):
+/// their coordinates and mask flags are sent once
+template <int D>
+void levelPlanner<D>::chooseGhosts()
+{
+    L_.ghostsTo.assign(nRanks_, {});
+    std::vector<std::vector<double>> gx(nRanks_);
+    std::vector<std::uint8_t> asked(nOwn_);
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        if (L_.tilesTo[r].empty()) continue;
+        std::fill(asked.begin(), asked.end(), 0);
+        for (const std::int64_t id : L_.tilesTo[r]) asked[id] = 1;
+        std::vector<std::uint32_t> g;
+        for (std::size_t q = 0; q < ctrl_.order.size(); ++q)
+            for (const std::int32_t id : ownIds_[q])
+                if (id >= 0 && asked[id]) { g.push_back(ctrl_.order[q]); break; }
+        if (g.size() >= std::size_t(npt)*L_.tilesTo[r].size()) continue;
+        for (const std::uint32_t i : g)
+        {
+            gx[r].insert(gx[r].end(), ctrl_.x[i], ctrl_.x[i] + D);
+            for (int c = 0; c < nc_; ++c) gx[r].push_back(ctrl_.constrains(i, c) ? 1.0 : 0.0);
+        }
+        L_.ghostsTo[r] = std::move(g);
+    }
+    L_.ghostsFrom = comm_.exchange(gx);
+}
+
+/// The view: own and received tiles, dense when that is not much larger;
+/// tilesTo and tilesFrom as view ids, the own tiles shared with lower ranks
+template <int D>
+void levelPlanner<D>::assembleView()
+{
+    std::int64_t upper = nOwn_;
+    for (const auto& kg : keysFrom_) upper += std::int64_t(kg.size());
+    std::int64_t denseTiles = 1;
+    for (int d = 0; d < D; ++d) denseTiles *= (nodes_[d] + tileEdge - 1)/tileEdge;
+    const bool dense = denseTiles <= 2*upper + 64;
+    if (nRanks_ == 1 && !dense)
+    {
+        // Serial and sparse: the own tiles and partial omega are the view
+        L_.view = std::move(L_.ownLayout);
+        L_.ownLayout = tileLayout<D>();
+        L_.ownIsView = true;
+        L_.invOmega = std::move(ownOmega_);
+        return;
+    }
+    L_.view.init(nodes_, dense);
+    std::vector<std::int64_t> ownToView(nOwn_);
+    for (std::int64_t id = 0; id < nOwn_; ++id) ownToView[id] = L_.view.findOrInsertKey(L_.ownLayout.keyOf(id));
+    for (int r = 0; r < nRanks_; ++r)
+        for (auto key : keysFrom_[r]) L_.tilesFrom[r].push_back(L_.view.findOrInsertKey(key));
+    for (auto& tiles : L_.tilesTo)
+        for (auto& id : tiles) id = ownToView[id];
+    std::vector<std::uint8_t> shared(L_.view.size(), 0);
+    for (std::int64_t id = 0; id < nOwn_; ++id) shared[ownToView[id]] = 1;
+    for (int r = 0; r < me_; ++r)
+        for (auto id : L_.tilesFrom[r])
+            if (shared[id] == 1) { shared[id] = 2; L_.sharedWithLower.push_back(id); }
+    sumOmega(ownToView);
+}
+
+/// omega on the view: the ranks' partial sums added in rank order
+template <int D>
+void levelPlanner<D>::sumOmega(const std::vector<std::int64_t>& ownToView)
+{
+    const int blk = npt*omegaPerNode_;
+    L_.invOmega.assign(L_.view.size()*blk, 0.0);
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        if (r == me_)
+        {
+            for (std::int64_t id = 0; id < nOwn_; ++id)
+                for (int j = 0; j < blk; ++j) L_.invOmega[ownToView[id]*blk + j] += ownOmega_[id*blk + j];
+        }
+        else
+        {
+            const auto& og = omegaFrom_[r];
+            for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
+                for (int j = 0; j < blk; ++j) L_.invOmega[L_.tilesFrom[r][t]*blk + j] += og[t*blk + j];
+        }
+    }
+}
+
+/// The view tiles of the own control points' stencils
+template <int D>
+void levelPlanner<D>::findControlTiles()
+{
+    if (L_.ownIsView)
+    {
+        L_.controlTiles = std::move(ownIds_);
+        return;
+    }
+    L_.controlTiles.resize(ctrl_.order.size());
+    std::size_t pos = 0;
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) {
+        findTiles(L_.view, st, L_.controlTiles[pos++]);
+    });
+}
+
+/// Separated: at every node of every own stencil, in every component the
+/// point constrains, omega (the sum over all ranks) is this point's own
+/// w^2 alone, summed as the plan summed it (0 + w*w: exact), also at nodes
+/// where its weight is 0 (a coarse level fails at its first points)
+template <int D>
+void levelPlanner<D>::testSeparation()
+{
+    bool alone = true;
+    for (std::size_t q = 0; q < ctrl_.order.size() && alone; ++q)
+    {
+        const std::size_t i = ctrl_.order[q];
+        detail::visitStencil(L_.controlTiles[q], ctrl_.stencilAt(q, L_.scale), [&](std::int64_t id, int n, double w) {
+            const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
+            for (int c = 0; c < omegaPerNode_; ++c)
+                if (omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c]) alone = alone && o[c] == w*w;
+        });
+    }
+    L_.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
+}
+
+/// The ghosts' stencil tiles, numbered as the tiles received from their rank
+template <int D>
+void levelPlanner<D>::findGhostTiles()
+{
+    L_.ghostTiles.assign(nRanks_, {});
+    for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
+    {
+        if (L_.ghostsFrom[r].empty()) continue;
+        std::vector<std::int32_t> at(L_.view.size(), -1);
+        for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t) at[L_.tilesFrom[r][t]] = std::int32_t(t);
+        const std::size_t stride = D + nc_, ng = L_.ghostsFrom[r].size()/stride;
+        L_.ghostTiles[r].resize(ng);
+        for (std::size_t g = 0; g < ng; ++g)
+        {
+            stencilTiles<D>& tid = L_.ghostTiles[r][g];
+            findTiles(L_.view, levelStencil<D>(dom_.local0(&L_.ghostsFrom[r][g*stride]), L_.scale), tid);
+            for (std::int32_t& id : tid) if (id >= 0) id = at[id];
+        }
+    }
+    for (const auto& g : L_.ghostsTo) L_.hasGhosts = L_.hasGhosts || !g.empty();
+    for (const auto& g : L_.ghostTiles) L_.hasGhosts = L_.hasGhosts || !g.empty();
+}
+
+template <int D>
+void levelPlanner<D>::fillStats()
+{
+    const levelPlan<D>& L = L_;
+    levelStats& s = L_.stats;
+    s.level = L.level;
+    s.h = dom_.h0/L.scale;
+    s.ownTiles = L.ownTiles().size();
+    s.viewTiles = L.view.size();
+    s.dense = L.view.dense();
+    s.separated = L.separated;
+    s.nodes = L.view.size()*npt;
+    s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
+        + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
+        + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
+        + L.scaledResiduals.capacity()*sizeof(double));
+    for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
+    {
+        s.tilesSent += std::int64_t(L.tilesTo[r].size());
+        s.tilesReceived += std::int64_t(L.tilesFrom[r].size());
+        s.messagesSent += !L.tilesTo[r].empty();
+        s.messagesReceived += !L.tilesFrom[r].empty();
+        s.ghostsSent += std::int64_t(L.ghostsTo[r].size());
+        s.ghostsReceived += std::int64_t(L.ghostTiles[r].size());
+        const std::int64_t vs = L.ghostsTo[r].empty() ? std::int64_t(L.tilesTo[r].size())*npt*nc_
+            : std::int64_t(L.ghostsTo[r].size())*nc_;
+        const std::int64_t vr = L.ghostTiles[r].empty() ? std::int64_t(L.tilesFrom[r].size())*npt*nc_
+            : std::int64_t(L.ghostTiles[r].size())*nc_;
+        s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
+        s.bytesReceivedPerApply += vr*std::int64_t(sizeof(double));
+        s.bytes += std::int64_t(L.ghostsFrom[r].capacity()*sizeof(double)
+            + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>));
+    }
+}
+
+} // namespace
+
+template <int D>
+levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                       const queryClusters<D>& clusters, int bucketTiles)
+{
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles).run(k);
+}
+
+template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
+template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
+template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
+                                   const queryClusters<2>&, int);
+template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
+                                   const queryClusters<3>&, int);
+
+} // namespace mba

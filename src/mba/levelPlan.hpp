@@ -1,0 +1,95 @@
+// bsplineMorph: OpenFOAM-free multilevel B-spline core (internal header)
+// The plan of one level, made the first time a fit needs the level and kept:
+// the tiles of this rank's partial sums ("own" tiles), the view (own and
+// received tiles) with 1/omega, and the communication pattern of an apply.
+//
+// Own tiles are clustered into buckets whose index boxes are all-gathered (a
+// small directory of who holds what); each rank asks the owners of the
+// buckets that meet its query points' stencils for exactly the tiles those
+// stencils touch and receives their partial sums in every apply. Where the
+// owner's control points that touch the asked tiles are fewer than the
+// tiles' nodes, it sends their coordinates once and their residuals per
+// apply instead ("ghosts"), and the asking rank forms the owner's partial
+// sums itself. A level is "separated" when no two control points share a
+// node: every node's phi then comes from one point alone.
+#ifndef MBA_LEVELPLAN_HPP
+#define MBA_LEVELPLAN_HPP
+
+#include "multilevel.hpp"
+#include "hugePages.hpp"
+#include "lattice.hpp"
+#include "pointSets.hpp"
+
+#include <deque>
+
+namespace mba {
+
+/// Clusters of this rank's query points (its active control points and its
+/// evaluation points): which remote buckets a level needs (parallel only)
+template <int D>
+struct queryClusters
+{
+    std::vector<box<D>> boxes;                      ///< bounding box of each cluster
+    std::vector<std::vector<const double*>> points; ///< the points of each cluster
+};
+
+/// Clusters of this rank's query points, of at least 64 points each (none
+/// on one rank)
+template <int D>
+queryClusters<D> clusterQueryPoints(const communicator& comm, const controlPoints<D>& ctrl, pointsView<D> eval);
+
+template <int D>
+struct levelPlan
+{
+    static constexpr int npt = tileLayout<D>::nodesPerTile;
+
+    int level = 0;                  ///< k: 0 the coarsest
+    double scale = 1;               ///< 2^k: level-k local coordinates u_k = u_0*scale
+    tileLayout<D> ownLayout;        ///< tiles holding this rank's partial sums (empty when ownIsView)
+    tileLayout<D> view;             ///< own and received tiles: where phi and 1/omega are stored
+    bool ownIsView = false;         ///< serial, sparse: the own tiles are the view (ownLayout left empty)
+
+    /// The coefficients at the view's nodes (tile id x node x component);
+    /// during an apply first the partial sums delta. Mutable: a separated
+    /// level's apply stores phi only where it is read every fit, and the
+    /// const evaluations that read the whole lattice store the rest, from
+    /// the last fit (storeDeferredCoefficients: a cache, not a change)
+    mutable hugeVector<double> phi;
+    hugeVector<double> invOmega;    ///< 1/omega at the view's nodes (0 where omega is), omegaPerNode a node
+
+    /// No two control points (of any rank) share a node of their stencils
+    /// (fine levels, where the points are farther apart than a stencil): a
+    /// point's nodes then take phi = w r/sum(w^2) from it alone, and its
+    /// residual after the level is r - (r/sum(w^2)) sum(w^2), 0 but for
+    /// rounding. Per fit the lattice is neither cleared (but for the tiles
+    /// other ranks' sums arrive in) nor scaled by 1/omega nor swept.
+    bool separated = false;
+    std::vector<std::uint8_t> readEveryFit;    ///< separated: per own point in order, its phi is stored every fit
+    std::vector<double> scaledResiduals;       ///< separated: per own point x component, r/sum(w^2) of the last fit
+    mutable bool allCoefficientsStored = true; ///< every own point's phi stored since the last fit
+
+    std::vector<std::vector<std::int64_t>> tilesTo;   ///< per rank: own tiles (view ids) whose partial sums it gets
+    std::vector<std::vector<std::int64_t>> tilesFrom; ///< per rank: view tiles its partial sums arrive in
+    /// Own tiles (view ids) that a lower rank also contributes to: this
+    /// rank's partial sums there are set aside and added in rank order
+    std::vector<std::int64_t> sharedWithLower;
+    std::vector<stencilTiles<D>> controlTiles; ///< the view tiles of the own control points' stencils, in order
+
+    std::vector<std::vector<std::uint32_t>> ghostsTo; ///< per rank: own points whose residuals go there (ghost mode)
+    std::vector<std::vector<double>> ghostsFrom;      ///< per rank: its ghosts, D coordinates + nc mask flags each
+    std::vector<std::vector<stencilTiles<D>>> ghostTiles; ///< per rank: its ghosts' tiles, as positions in tilesFrom
+    bool hasGhosts = false;         ///< this rank sends or receives ghosts at this level
+
+    levelStats stats;
+
+    /// The layout of the own tiles
+    const tileLayout<D>& ownTiles() const { return ownIsView ? view : ownLayout; }
+};
+
+/// Plans level k. Collective.
+template <int D>
+levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                       const queryClusters<D>& clusters, int bucketTiles);
+
+} // namespace mba
+#endif

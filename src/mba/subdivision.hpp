@@ -1,0 +1,21 @@
+// bsplineMorph: OpenFOAM-free multilevel B-spline core (internal header)
+// Uniform cubic B-spline subdivision: the coefficients of one level refined
+// to the next (half the cell edge) represent the same function exactly, so
+// the coarse levels can be summed on the lattice of a finer one.
+#ifndef MBA_SUBDIVISION_HPP
+#define MBA_SUBDIVISION_HPP
+
+#include "geometry.hpp"
+#include "hugePages.hpp"
+
+namespace mba {
+
+/// Values G (nc per node, the last direction fastest) on the node box cb of
+/// one level, refined to the next level on the node box fb, one direction at
+/// a time (the parents of fb's nodes that the stencils of points inside the
+/// boxes use lie in cb). T: scratch, swapped with G
+template <int D>
+void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, hugeVector<double>& T);
+
+} // namespace mba
+#endif
