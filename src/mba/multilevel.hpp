@@ -50,8 +50,8 @@ struct params
     /// Cells along the longest edge of the domain at level 0 (>= 1)
     int initialGrid = 1;
     /// Least-squares affine initial approximation, subtracted before the levels,
-    /// so that translations, rotations-free shears and scalings of all control
-    /// points are reproduced exactly everywhere (default on: a rigid motion of
+    /// so that any affine motion of all control points (translations, rotations,
+    /// scalings, shears) is reproduced exactly everywhere (default on: a rigid motion of
     /// the whole boundary then moves the whole mesh rigidly)
     bool affine = true;
     /// Padding of the bounding box on each side, relative to its largest extent (> 0)
