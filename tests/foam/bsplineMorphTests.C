@@ -17,6 +17,7 @@
 #include "fvMesh.H"
 #include "volFields.H"
 #include "primitiveMeshTools.H"
+#include "vectorWidth.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -240,6 +241,12 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
             }
             const invertedCellCheck::result r = check.check(p);
             const label expected = checkMeshInvalidCells(mesh, p);
+            // (hexahedra two at a time: the same verdicts)
+            const bool wide = mba::useWideVectors(false);
+            const invertedCellCheck::result narrow = check.check(p);
+            mba::useWideVectors(wide);
+            CHECK(narrow.nInvalid == r.nInvalid);
+            CHECK(narrow.nJudged == r.nJudged);
             INFO("push " << s << ": " << r.nInvalid << " invalid (" << r.nNonPositive
                 << " non-positive, " << r.nFolded << " folded), checkMesh " << expected);
             CHECK(r.nInvalid == expected);

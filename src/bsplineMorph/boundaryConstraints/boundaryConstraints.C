@@ -146,14 +146,11 @@ Foam::boundaryConstraints::boundaryConstraints
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement)
+void Foam::boundaryConstraints::resetPointArrays()
 {
-    const polyMesh& mesh = pMesh_();
-    const label nPoints = mesh.nPoints();
-    const vectorField& disp = pointDisplacement.primitiveField();
-
     // The per-point arrays keep their storage from step to step (no new
     // pages for the mesh-sized arrays at every step)
+    const label nPoints = pMesh_().nPoints();
     labelList& fixed = fixedSync_;
     if (fixed.size() != nPoints)
     {
@@ -180,112 +177,124 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
             slide_[pointi] = pointConstraint();
         }
     }
-    wordHashSet badPatches;
-    wordHashSet emptyDirectionPatches;
-    const Vector<label>& solD = mesh.solutionD();
+}
 
-    forAll(pointDisplacement.boundaryField(), patchi)
+
+void Foam::boundaryConstraints::readFixedPatch
+(
+    const pointPatchVectorField& pf,
+    const vectorField& disp,
+    wordHashSet& nonFinite,
+    wordHashSet& emptyDirection
+)
+{
+    const pointPatch& pp = pf.patch();
+    const labelList& meshPoints = pp.meshPoints();
+    const Vector<label>& solD = pMesh_().solutionD();
+    // The condition's own values (the internal field at a point on a fixed
+    // and a slip patch depends on their evaluation order)
+    const valuePointPatchVectorField* vpf = isA<valuePointPatchVectorField>(pf);
+    const vectorField values
+    (
+        vpf
+      ? static_cast<const vectorField&>(*vpf)
+      : vectorField(disp, meshPoints)
+    );
+    forAll(meshPoints, i)
     {
-        const pointPatchVectorField& pf = pointDisplacement.boundaryField()[patchi];
-        const pointPatch& pp = pf.patch();
-        const labelList& meshPoints = pp.meshPoints();
-
-        if (pp.coupled() || pf.type() == "empty")
+        const label pointi = meshPoints[i];
+        fixedSync_[pointi] = 1;
+        value_[pointi] = values[i];
+        for (direction c = 0; c < 3; ++c)
         {
-            continue;
-        }
-        if (pf.fixesValue())
-        {
-            // The condition's own values (the internal field at a point on a
-            // fixed and a slip patch depends on their evaluation order)
-            const valuePointPatchVectorField* vpf =
-                isA<valuePointPatchVectorField>(pf);
-            const vectorField values
-            (
-                vpf
-              ? static_cast<const vectorField&>(*vpf)
-              : vectorField(disp, meshPoints)
-            );
-            forAll(meshPoints, i)
+            if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
+            if (solD[c] != 1 && values[i][c] != 0)
             {
-                const label pointi = meshPoints[i];
-                fixed[pointi] = 1;
-                value_[pointi] = values[i];
-                for (direction c = 0; c < 3; ++c)
-                {
-                    if (!std::isfinite(values[i][c])) badPatches.insert(pp.name());
-                    if (solD[c] != 1 && values[i][c] != 0)
-                    {
-                        emptyDirectionPatches.insert(pp.name());
-                    }
-                }
-            }
-        }
-        else if (pf.type() == "slip" || pp.constraintType() == "symmetry")
-        {
-            // Each face's own normal on each of its points, combined (plane,
-            // line, fixed): a patch spanning several planes (the faces of a
-            // box) constrains its edge points to the line where they meet.
-            // Averaged point normals would not: they tilt at edges and differ
-            // between the ranks that share a point.
-            const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
-            const vectorField& nf = patch.faceNormals();
-            const faceList& lf = patch.localFaces();
-            forAll(lf, facei)
-            {
-                for (const label lp : lf[facei])
-                {
-                    slide_[meshPoints[lp]].applyConstraint(nf[facei]);
-                }
-            }
-        }
-        else if (pf.type() == "fixedNormalSlip")
-        {
-            // The normal is private to the condition: read it back from its output
-            OStringStream os;
-            pf.write(os);
-            const dictionary d(IStringStream(os.str())());
-            vector n = d.get<vector>("n");
-            n /= mag(n) + VSMALL;
-            for (const label pointi : meshPoints)
-            {
-                slide_[pointi].applyConstraint(n);
-            }
-        }
-        else if (pp.constraintType() != word::null)
-        {
-            // symmetryPlane, wedge, cyclicSlip: the patch's own constraint
-            forAll(meshPoints, i)
-            {
-                pointConstraint pc;
-                pp.applyConstraint(i, pc);
-                slide_[meshPoints[i]].combine(pc);
+                emptyDirection.insert(pp.name());
             }
         }
     }
+}
+
+
+void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf)
+{
+    const pointPatch& pp = pf.patch();
+    const labelList& meshPoints = pp.meshPoints();
+    if (pf.type() == "slip" || pp.constraintType() == "symmetry")
+    {
+        // Each face's own normal on each of its points, combined (plane,
+        // line, fixed): a patch spanning several planes (the faces of a box)
+        // constrains its edge points to the line where they meet. Averaged
+        // point normals would not: they tilt at edges and differ between the
+        // ranks that share a point.
+        const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
+        const vectorField& nf = patch.faceNormals();
+        const faceList& lf = patch.localFaces();
+        forAll(lf, facei)
+        {
+            for (const label lp : lf[facei])
+            {
+                slide_[meshPoints[lp]].applyConstraint(nf[facei]);
+            }
+        }
+    }
+    else if (pf.type() == "fixedNormalSlip")
+    {
+        // The normal is private to the condition: read it back from its output
+        OStringStream os;
+        pf.write(os);
+        const dictionary d(IStringStream(os.str())());
+        vector n = d.get<vector>("n");
+        n /= mag(n) + VSMALL;
+        for (const label pointi : meshPoints)
+        {
+            slide_[pointi].applyConstraint(n);
+        }
+    }
+    else if (pp.constraintType() != word::null)
+    {
+        // symmetryPlane, wedge, cyclicSlip: the patch's own constraint
+        forAll(meshPoints, i)
+        {
+            pointConstraint pc;
+            pp.applyConstraint(i, pc);
+            slide_[meshPoints[i]].combine(pc);
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::checkPrescribed
+(
+    wordHashSet& nonFinite,
+    wordHashSet& emptyDirection
+)
+{
+    const polyMesh& mesh = pMesh_();
 
     // Non-finite values stop everything here, on every rank, before they
     // reach any arithmetic (with FOAM_SIGFPE a NaN comparison traps)
-    Pstream::combineGather(badPatches, HashSetOps::plusEqOp<word>());
-    Pstream::combineScatter(badPatches);
-    if (badPatches.size())
+    Pstream::combineGather(nonFinite, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(nonFinite);
+    if (nonFinite.size())
     {
         FatalErrorInFunction
             << "pointDisplacement has non-finite (NaN or Inf) values on patches "
-            << flatOutput(badPatches.sortedToc()) << " at time "
+            << flatOutput(nonFinite.sortedToc()) << " at time "
             << mesh.time().timeName() << "; the mesh is not moved"
             << exit(FatalError);
     }
 
     // A 2D case moves in its plane: a prescribed component out of it is
     // dropped, with a warning (once per patch)
-    Pstream::combineGather(emptyDirectionPatches, HashSetOps::plusEqOp<word>());
-    Pstream::combineScatter(emptyDirectionPatches);
-    emptyDirectionPatches -= warnedEmptyDirection_;
-    if (emptyDirectionPatches.size())
+    Pstream::combineGather(emptyDirection, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(emptyDirection);
+    emptyDirection -= warnedEmptyDirection_;
+    if (emptyDirection.size())
     {
         OStringStream names;
-        for (const word& name : emptyDirectionPatches.sortedToc())
+        for (const word& name : emptyDirection.sortedToc())
         {
             names<< ' ' << name;
         }
@@ -295,17 +304,45 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
             << names.str().c_str() << ", at time "
             << mesh.time().timeName() << ": that component is dropped (the"
             << " mesh moves in its plane only)" << endl;
-        warnedEmptyDirection_ += emptyDirectionPatches;
+        warnedEmptyDirection_ += emptyDirection;
     }
+}
+
+
+void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement)
+{
+    resetPointArrays();
+    wordHashSet nonFinite;
+    wordHashSet emptyDirection;
+    for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
+    {
+        if (pf.patch().coupled() || pf.type() == "empty")
+        {
+            continue;
+        }
+        if (pf.fixesValue())
+        {
+            readFixedPatch
+            (
+                pf, pointDisplacement.primitiveField(), nonFinite, emptyDirection
+            );
+        }
+        else
+        {
+            readSlidingPatch(pf);
+        }
+    }
+    checkPrescribed(nonFinite, emptyDirection);
 
     // The same view of every processor-shared point on all its ranks
-    syncTools::syncPointList(mesh, fixed, maxEqOp<label>(), label(0));
+    const polyMesh& mesh = pMesh_();
+    syncTools::syncPointList(mesh, fixedSync_, maxEqOp<label>(), label(0));
     syncTools::syncPointList(mesh, value_, maxMagSqrEqOp<vector>(), vector::zero);
     syncTools::syncPointList(mesh, slide_, combineConstraintsEqOp(), pointConstraint());
 
     for (const label pointi : boundaryPoints_)
     {
-        fixed_[pointi] = fixed[pointi] != 0;
+        fixed_[pointi] = fixedSync_[pointi] != 0;
     }
     collectControls();
 }

@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "invertedCellCheck.H"
+#include "vectorWidth.hpp"
 
 #include <string>
 #include <unordered_map>
@@ -122,8 +123,8 @@ namespace
         screenHexes<2>(hexPoints, hexCells, points, candidates);
     }
 
-    #if defined(__GNUC__) && defined(__x86_64__)
-    __attribute__((target("avx2,fma")))
+    #ifdef MBA_WIDE_VECTORS
+    MBA_WIDE_TARGET
     void screenHexes4
     (
         const labelList& hexPoints,
@@ -204,6 +205,73 @@ namespace
         return matched == 63;
     }
 
+    //- The faces of each cell (cellFaces from faceStart[celli] to
+    //  faceStart[celli + 1]), in cells() order (the owned ones, then the
+    //  others, each ascending), without the mesh's cached cells()
+    void cellFaceLists
+    (
+        const polyMesh& mesh,
+        labelList& faceStart,
+        labelList& cellFaces
+    )
+    {
+        const labelList& own = mesh.faceOwner();
+        const labelList& nei = mesh.faceNeighbour();
+        const label nCells = mesh.nCells();
+        faceStart.setSize(nCells + 1);
+        faceStart = 0;
+        for (const label celli : own) ++faceStart[celli + 1];
+        for (const label celli : nei) ++faceStart[celli + 1];
+        for (label celli = 0; celli < nCells; ++celli)
+        {
+            faceStart[celli + 1] += faceStart[celli];
+        }
+        cellFaces.setSize(faceStart.last());
+        labelList fill(SubList<label>(faceStart, nCells));
+        forAll(own, facei) cellFaces[fill[own[facei]]++] = facei;
+        forAll(nei, facei) cellFaces[fill[nei[facei]]++] = facei;
+    }
+
+    //- A cell's points, each once, and its layout: the number of faces,
+    //  then per face its number of points and their positions in points,
+    //  turned to point out of the cell
+    void cellLayout
+    (
+        const polyMesh& mesh,
+        const label celli,
+        const labelList& faceStart,
+        const labelList& cellFaces,
+        std::vector<label>& points,
+        std::basic_string<std::uint16_t>& layout
+    )
+    {
+        const faceList& faces = mesh.faces();
+        const labelList& own = mesh.faceOwner();
+        points.clear();
+        layout.assign(1, std::uint16_t(faceStart[celli + 1] - faceStart[celli]));
+        for (label i = faceStart[celli]; i < faceStart[celli + 1]; ++i)
+        {
+            const face& f = faces[cellFaces[i]];
+            const bool owned = own[cellFaces[i]] == celli;
+            layout.push_back(std::uint16_t(f.size()));
+            forAll(f, k)
+            {
+                // (the neighbour's face reversed: the first point, the last, ...)
+                const label pointi = owned || k == 0 ? f[k] : f[f.size() - k];
+                label at = 0;
+                while (at < label(points.size()) && points[at] != pointi) ++at;
+                if (at == label(points.size())) points.push_back(pointi);
+                if (at > 65535)
+                {
+                    FatalErrorInFunction
+                        << "Cell " << celli << " has more than 65536 points"
+                        << exit(FatalError);
+                }
+                layout.push_back(std::uint16_t(at));
+            }
+        }
+    }
+
     //- A face's centre and area as primitiveMesh::makeFaceCentresAndAreas
     //  makes them (the same operations in the same order)
     void checkMeshFaceGeometry
@@ -268,60 +336,20 @@ Foam::invertedCellCheck::invertedCellCheck
     mesh_(mesh),
     maxCellPoints_(1)
 {
-    // The cells' faces (a list per cell, in cells() order, without the
-    // mesh's cached cells())
-    const faceList& faces = mesh.faces();
-    const labelList& own = mesh.faceOwner();
-    const labelList& nei = mesh.faceNeighbour();
-    const label nCells = mesh.nCells();
-    labelList faceStart(nCells + 1, 0);
-    for (const label celli : own) ++faceStart[celli + 1];
-    for (const label celli : nei) ++faceStart[celli + 1];
-    for (label celli = 0; celli < nCells; ++celli)
-    {
-        faceStart[celli + 1] += faceStart[celli];
-    }
-    labelList cellFaces(faceStart.last());
-    labelList fill(SubList<label>(faceStart, nCells));
-    forAll(own, facei) cellFaces[fill[own[facei]]++] = facei;
-    forAll(nei, facei) cellFaces[fill[nei[facei]]++] = facei;
+    labelList faceStart, cellFaces;
+    cellFaceLists(mesh, faceStart, cellFaces);
 
-    // Each cell's points, each once, and its faces as positions in that list
-    // (turned to point out of the cell), the same layouts shared
+    // Each cell's points and layout: hexahedra in the model's order, the
+    // other cells with their layouts (the same layouts shared)
     std::unordered_map<std::string, label> layoutIndex;
     std::basic_string<std::uint16_t> layout;
-    DynamicList<label> hexPoints(8*nCells);
-    DynamicList<label> hexCells(nCells);
-    DynamicList<label> otherStart;
-    DynamicList<label> otherPoints;
-    DynamicList<label> otherCells;
-    DynamicList<label> otherLayout;
     std::vector<label> points;
-    for (label celli = 0; celli < nCells; ++celli)
+    DynamicList<label> hexPoints(8*mesh.nCells());
+    DynamicList<label> hexCells(mesh.nCells());
+    DynamicList<label> otherStart, otherPoints, otherCells, otherLayout;
+    for (label celli = 0; celli < mesh.nCells(); ++celli)
     {
-        points.clear();
-        layout.assign(1, std::uint16_t(faceStart[celli + 1] - faceStart[celli]));
-        for (label i = faceStart[celli]; i < faceStart[celli + 1]; ++i)
-        {
-            const face& f = faces[cellFaces[i]];
-            const bool owned = own[cellFaces[i]] == celli;
-            layout.push_back(std::uint16_t(f.size()));
-            forAll(f, k)
-            {
-                // (the neighbour's face reversed: the first point, the last, ...)
-                const label pointi = owned || k == 0 ? f[k] : f[f.size() - k];
-                label at = 0;
-                while (at < label(points.size()) && points[at] != pointi) ++at;
-                if (at == label(points.size())) points.push_back(pointi);
-                if (at > 65535)
-                {
-                    FatalErrorInFunction
-                        << "Cell " << celli << " has more than 65536 points"
-                        << exit(FatalError);
-                }
-                layout.push_back(std::uint16_t(at));
-            }
-        }
+        cellLayout(mesh, celli, faceStart, cellFaces, points, layout);
         int order[8];
         if (hexKernel && points.size() == 8 && hexOrder(layout, order))
         {
@@ -363,27 +391,12 @@ Foam::invertedCellCheck::invertedCellCheck
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-Foam::invertedCellCheck::result
-Foam::invertedCellCheck::check(const pointField& points) const
+void Foam::invertedCellCheck::screenOtherCells
+(
+    const pointField& points,
+    DynamicList<label>& candidates
+) const
 {
-    // The screen, one pass over the cells: a cell's points, their mean, its
-    // faces' pyramids against it (times six: twice the area, three times
-    // the volume); a cell whose smallest pyramid is at or under
-    // screenFraction of their mean (one of non-positive volume always is)
-    // is judged by checkMesh's formulas. Hexahedra first, four at a time
-    // where the processor has AVX2 (else two).
-    DynamicList<label> candidates;
-    #if defined(__GNUC__) && defined(__x86_64__)
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-    {
-        screenHexes4(hexPoints_, hexCells_, points, candidates);
-    }
-    else
-    #endif
-    {
-        screenHexes2(hexPoints_, hexCells_, points, candidates);
-    }
-
     // The other cells, their faces from their layouts
     List<point> p(maxCellPoints_);
     forAll(otherCells_, otheri)
@@ -440,6 +453,31 @@ Foam::invertedCellCheck::check(const pointField& points) const
             candidates.append(otherCells_[otheri]);
         }
     }
+}
+
+
+Foam::invertedCellCheck::result
+Foam::invertedCellCheck::check(const pointField& points) const
+{
+    // The screen, one pass over the cells: a cell's points, their mean, its
+    // faces' pyramids against it (times six: twice the area, three times
+    // the volume); a cell whose smallest pyramid is at or under
+    // screenFraction of their mean (one of non-positive volume always is)
+    // is judged by checkMesh's formulas. Hexahedra first, four at a time
+    // where the core's kernels run on four doubles (mba::wideVectors: AVX2),
+    // else two.
+    DynamicList<label> candidates;
+    #ifdef MBA_WIDE_VECTORS
+    if (mba::wideVectors())
+    {
+        screenHexes4(hexPoints_, hexCells_, points, candidates);
+    }
+    else
+    #endif
+    {
+        screenHexes2(hexPoints_, hexCells_, points, candidates);
+    }
+    screenOtherCells(points, candidates);
 
     result r;
     r.where = boundBox::invertedBox;
