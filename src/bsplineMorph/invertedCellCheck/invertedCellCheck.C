@@ -137,20 +137,11 @@ namespace
     }
     #endif
 
-    //- A cell's layout (number of faces, then per face its size and its
-    //  points' positions, outward) as a hexahedron: its 8 positions in the
-    //  hex model's order, or false when it is not one (6 quadrilaterals on
-    //  8 points, the model's faces)
-    bool hexOrder(const std::basic_string<std::uint16_t>& layout, int order[8])
+    //- A cell of 6 quadrilaterals on 8 points (its faces as positions among
+    //  its points, outward) as a hexahedron: its 8 positions in the hex
+    //  model's order, or false when its faces are not the model's
+    bool hexOrder(const std::uint16_t f[6][4], int order[8])
     {
-        if (layout.size() != 1 + 6*5 || layout[0] != 6) return false;
-        const std::uint16_t* f[6];
-        for (int i = 0; i < 6; ++i)
-        {
-            f[i] = &layout[1 + 5*i];
-            if (f[i][0] != 4) return false;
-            ++f[i];
-        }
         // The first face is the model's (0 3 2 1); each of its points' edge
         // to a point off it (an edge of a face: two consecutive points) is
         // the model's vertical edge to 4, 5, 6, 7
@@ -272,6 +263,48 @@ namespace
         }
     }
 
+    //- A hexahedron's points in the hex model's order, or false when the
+    //  cell is not one (the points in the order cellLayout would list them)
+    bool hexCell
+    (
+        const polyMesh& mesh,
+        const label celli,
+        const labelList& faceStart,
+        const labelList& cellFaces,
+        label hexPoints[8]
+    )
+    {
+        if (faceStart[celli + 1] - faceStart[celli] != 6) return false;
+        const faceList& faces = mesh.faces();
+        const labelList& own = mesh.faceOwner();
+        label points[8];
+        int nPoints = 0;
+        std::uint16_t quads[6][4];
+        for (int i = 0; i < 6; ++i)
+        {
+            const label facei = cellFaces[faceStart[celli] + i];
+            const face& f = faces[facei];
+            if (f.size() != 4) return false;
+            const bool owned = own[facei] == celli;
+            for (int k = 0; k < 4; ++k)
+            {
+                const label pointi = owned || k == 0 ? f[k] : f[4 - k];
+                int at = 0;
+                while (at < nPoints && points[at] != pointi) ++at;
+                if (at == nPoints)
+                {
+                    if (nPoints == 8) return false;
+                    points[nPoints++] = pointi;
+                }
+                quads[i][k] = std::uint16_t(at);
+            }
+        }
+        int order[8];
+        if (nPoints != 8 || !hexOrder(quads, order)) return false;
+        for (int k = 0; k < 8; ++k) hexPoints[k] = points[order[k]];
+        return true;
+    }
+
     //- A face's centre and area as primitiveMesh::makeFaceCentresAndAreas
     //  makes them (the same operations in the same order)
     void checkMeshFaceGeometry
@@ -349,14 +382,14 @@ Foam::invertedCellCheck::invertedCellCheck
     DynamicList<label> otherStart, otherPoints, otherCells, otherLayout;
     for (label celli = 0; celli < mesh.nCells(); ++celli)
     {
-        cellLayout(mesh, celli, faceStart, cellFaces, points, layout);
-        int order[8];
-        if (hexKernel && points.size() == 8 && hexOrder(layout, order))
+        label hex[8];
+        if (hexKernel && hexCell(mesh, celli, faceStart, cellFaces, hex))
         {
-            for (int k = 0; k < 8; ++k) hexPoints.append(points[order[k]]);
+            for (int k = 0; k < 8; ++k) hexPoints.append(hex[k]);
             hexCells.append(celli);
             continue;
         }
+        cellLayout(mesh, celli, faceStart, cellFaces, points, layout);
         maxCellPoints_ = max(maxCellPoints_, label(points.size()));
         otherCells.append(celli);
         otherStart.append(otherPoints.size());
