@@ -88,7 +88,7 @@ template <int NC>
 MBA_WIDE_TARGET void flatSweepBlocks(const double* G, const indexBox<3>& b, double sf, const point<3>* u0,
                                      std::size_t n, double* out)
 {
-    typedef detail::vec<4>::type v4d;
+    typedef vec<4>::type v4d;
     typedef int v4i __attribute__((vector_size(16)));
     const std::int64_t n1 = b.hi[1] - b.lo[1] + 1, n2 = b.hi[2] - b.lo[2] + 1;
     index<3> last;

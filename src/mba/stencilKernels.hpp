@@ -15,19 +15,6 @@
 namespace mba {
 
 namespace detail {
-/// Vectors of W doubles (GCC's vector extension): W = 2 is SSE2 on x86-64 and
-/// NEON on arm64; W = 4 (AVX2) only in code compiled for it (wideVectors)
-template <int W> struct vec;
-template <> struct vec<2>
-{
-    typedef double type __attribute__((vector_size(16)));
-    typedef double unaligned __attribute__((vector_size(16), aligned(8), may_alias)); ///< in arrays of double
-};
-template <> struct vec<4>
-{
-    typedef double type __attribute__((vector_size(32)));
-    typedef double unaligned __attribute__((vector_size(32), aligned(8), may_alias));
-};
 typedef vec<2>::type v2d;
 typedef vec<2>::unaligned v2du;
 

@@ -46,5 +46,19 @@ inline bool useWideVectors(bool on)
     return was;
 }
 
+/// Vectors of W doubles (GCC's vector extension): W = 2 is SSE2 on x86-64 and
+/// NEON on arm64; W = 4 (AVX2) only in code compiled for it (MBA_WIDE_TARGET)
+template <int W> struct vec;
+template <> struct vec<2>
+{
+    typedef double type __attribute__((vector_size(16)));
+    typedef double unaligned __attribute__((vector_size(16), aligned(8), may_alias)); ///< in arrays of double
+};
+template <> struct vec<4>
+{
+    typedef double type __attribute__((vector_size(32)));
+    typedef double unaligned __attribute__((vector_size(32), aligned(8), may_alias));
+};
+
 } // namespace mba
 #endif

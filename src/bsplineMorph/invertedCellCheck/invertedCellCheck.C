@@ -34,18 +34,6 @@ namespace
         {3, 7, 6, 2}, {0, 3, 2, 1}, {4, 5, 6, 7}
     };
 
-    //- Vectors of W doubles (GCC's vector extension): W = 2 is SSE2;
-    //  W = 4 (AVX2) only in code compiled for it
-    template<int W> struct lanes;
-    template<> struct lanes<2>
-    {
-        typedef double type __attribute__((vector_size(16)));
-    };
-    template<> struct lanes<4>
-    {
-        typedef double type __attribute__((vector_size(32)));
-    };
-
     //- The screen of hexahedra, W at a time: each one's points (8 labels
     //  per cell, the model's order) and centre (their mean), its faces'
     //  pyramids against it (times six: twice the area, three times the
@@ -60,7 +48,7 @@ namespace
         DynamicList<label>& candidates
     )
     {
-        typedef typename lanes<W>::type vd;
+        typedef typename mba::vec<W>::type vd;
         const label nHex = hexCells.size();
         const scalar fraction = invertedCellCheck::screenFraction/6;
         for (label c = 0; c < nHex; c += W)
@@ -137,6 +125,13 @@ namespace
     }
     #endif
 
+    //- A face of the hex model as the set of its vertices (bit v: vertex v)
+    constexpr int modelFace(const int m)
+    {
+        return 1 << hexFaces[m][0] | 1 << hexFaces[m][1]
+             | 1 << hexFaces[m][2] | 1 << hexFaces[m][3];
+    }
+
     //- A cell of 6 quadrilaterals on 8 points (its faces as positions among
     //  its points, outward) as a hexahedron: its 8 positions in the hex
     //  model's order, or false when its faces are not the model's
@@ -177,12 +172,6 @@ namespace
             if (order[k] > 7 || modelVertex[order[k]] >= 0) return false;
             modelVertex[order[k]] = k;
         }
-        int modelFaces[6];
-        for (int m = 0; m < 6; ++m)
-        {
-            modelFaces[m] = 0;
-            for (int k = 0; k < 4; ++k) modelFaces[m] |= 1 << hexFaces[m][k];
-        }
         int matched = 0;
         for (int i = 0; i < 6; ++i)
         {
@@ -190,7 +179,7 @@ namespace
             for (int j = 0; j < 4; ++j) bits |= 1 << modelVertex[f[i][j]];
             for (int m = 0; m < 6; ++m)
             {
-                if (bits == modelFaces[m]) matched |= 1 << m;
+                if (bits == modelFace(m)) matched |= 1 << m;
             }
         }
         return matched == 63;
