@@ -287,7 +287,12 @@ void Foam::boundaryConstraints::checkPrescribed
     }
 
     // A 2D case moves in its plane: a prescribed component out of it is
-    // dropped, with a warning (once per patch)
+    // dropped, with a warning (once per patch; a 3D case has none to
+    // gather, on any rank)
+    if (directions_.size() == 3)
+    {
+        return;
+    }
     Pstream::combineGather(emptyDirection, HashSetOps::plusEqOp<word>());
     Pstream::combineScatter(emptyDirection);
     emptyDirection -= warnedEmptyDirection_;

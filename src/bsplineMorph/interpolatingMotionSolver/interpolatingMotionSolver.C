@@ -23,7 +23,7 @@ License
 #include "OFstream.H"
 #include "OSspecific.H"
 #include "coeffsInput.H"
-#include "setSizeOnHugePages.H"
+#include "hugePages.hpp"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
@@ -39,6 +39,20 @@ namespace Foam
             { onInverted::fatal, "fatal" },
             { onInverted::warn, "warn" },
         });
+
+        //- Size a mesh-sized work array swept every step; when it is
+        //  allocated, ask for huge pages before it is first written (as the
+        //  core's arrays; best effort: malloc may hand out memory written
+        //  before, which keeps its pages)
+        template<class T>
+        void setSizeOnHugePages(List<T>& list, const label n)
+        {
+            if (list.size() != n)
+            {
+                list.setSize(n);
+                mba::adviseHugePages(list.data(), n*sizeof(T));
+            }
+        }
 
         bool readInvertedCellsFatal(const dictionary& dict)
         {
