@@ -148,7 +148,11 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
     scaleResiduals(rr, residuals);
     scatterOwn(L, rr);
     L.allCoefficientsStored = !L.separated;
-    if (comm_.size() > 1) exchangePartialSums(L, residuals);
+    if (comm_.size() > 1)
+    {
+        if (L.chunked) exchangeChunks(L);
+        else exchangePartialSums(L, residuals);
+    }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
     // too); separated levels hold phi already
     if (!L.separated) divideByOmega(L);
@@ -202,8 +206,8 @@ void levelApplier<D>::scaleResiduals(std::vector<double>& rr, const std::vector<
 
 /// This rank's partial sums delta (separated: phi at the points read every
 /// fit). Runs of points with the same stencil nodes at once (coarse
-/// levels); short runs point after point, and every point at a level with
-/// ghosts, as the ranks holding them as ghosts form their sums
+/// levels), short runs point after point: as the ranks holding them as
+/// ghosts form their sums (ghostPartialSums)
 template <int D>
 void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr) const
 {
@@ -220,11 +224,10 @@ void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr)
         }
         return;
     }
-    const std::size_t shortest = L.hasGhosts ? nq + 1 : minRun;
     for (std::size_t q = 0, e; q < nq; q = e)
     {
         for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
-        if (e - q >= shortest)
+        if (e - q >= minRun)
             scatterRun<D>(L.phi.data(), nc, L.controlTiles[q], &cubedStencils_[q], &rr[q*nc], e - q);
         else
             for (std::size_t j = q; j < e; ++j)
@@ -257,29 +260,46 @@ void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<dou
 }
 
 /// Rank r's partial delta on the tiles received from it, formed from its
-/// ghosts' residuals (got: nc a ghost) as r forms it
+/// ghosts' residuals (got: nc a ghost) as r forms it: a run of points with
+/// the same stencil nodes is sent whole or not at all (its points touch the
+/// same tiles), and scattered as a run here as there
 template <int D>
 std::vector<double> levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got) const
 {
     const int nc = ctrl_.nComponents, blk = levelPlan<D>::npt*nc;
-    const std::size_t stride = D + nc;
+    const std::size_t stride = D + nc, ng = L.ghostTiles[r].size();
     std::vector<double> dl(L.tilesFrom[r].size()*blk, 0.0);
-    for (std::size_t g = 0; g < L.ghostTiles[r].size(); ++g)
+    std::vector<stencil<D>> st(ng);
+    std::vector<double> rr(ng*nc, 0.0);
+    std::vector<std::uint8_t> on(ng*nc);
+    for (std::size_t g = 0; g < ng; ++g)
     {
         const double* x = &L.ghostsFrom[r][g*stride];
-        const stencil<D> st = levelStencil<D>(dom_.local0(x), L.scale);
-        const double isw = 1/st.sumSquares();
-        double rr[3] = {0, 0, 0};
-        bool on[3];
+        st[g] = levelStencil<D>(dom_.local0(x), L.scale);
+        const double isw = 1/st[g].sumSquares();
         for (int c = 0; c < nc; ++c)
         {
-            on[c] = x[D + c] != 0;
-            rr[c] = on[c] ? got[g*nc + c]*isw : 0.0;
+            on[g*nc + c] = x[D + c] != 0;
+            rr[g*nc + c] = on[g*nc + c] ? got[g*nc + c]*isw : 0.0;
         }
-        // as the owner does
-        if (L.separated)
-            scatterSeparated<D>(dl.data(), nc, L.ghostTiles[r][g], st, rr, ctrl_.omegaPerNode == 1 ? nullptr : on);
-        else scatter<D>(dl.data(), nc, L.ghostTiles[r][g], st.cubedWeights(), rr);
+    }
+    if (L.separated)
+    {
+        for (std::size_t g = 0; g < ng; ++g)
+        {
+            bool o[3];
+            for (int c = 0; c < nc; ++c) o[c] = on[g*nc + c];
+            scatterSeparated<D>(dl.data(), nc, L.ghostTiles[r][g], st[g], &rr[g*nc],
+                                ctrl_.omegaPerNode == 1 ? nullptr : o);
+        }
+        return dl;
+    }
+    for (auto& s : st) s = s.cubedWeights();
+    for (std::size_t g = 0, e; g < ng; g = e)
+    {
+        for (e = g + 1; e < ng && st[e].base == st[g].base; ++e) {}
+        if (e - g >= minRun) scatterRun<D>(dl.data(), nc, L.ghostTiles[r][g], &st[g], &rr[g*nc], e - g);
+        else for (std::size_t j = g; j < e; ++j) scatter<D>(dl.data(), nc, L.ghostTiles[r][j], st[j], &rr[j*nc]);
     }
     return dl;
 }
@@ -311,6 +331,48 @@ void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<std::vec
             for (std::size_t t = 0; t < L.sharedWithLower.size(); ++t) add(L.sharedWithLower[t], &own[t*blk]);
         else
             for (std::size_t t = 0; t < L.tilesFrom[r].size(); ++t) add(L.tilesFrom[r][t], &got[r][t*blk]);
+    }
+}
+
+/// The chunked exchange (levelPlan::chunks): own partial sums to the
+/// chunks' owners; each owner sums its chunks in rank order (as
+/// addInRankOrder: the same values) and sends them to the tiles' readers
+template <int D>
+void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
+{
+    const int P = comm_.size(), me = comm_.rank(), nc = ctrl_.nComponents, npt = levelPlan<D>::npt;
+    const chunkExchange& X = L.chunks;
+    auto at = [&](const nodeRun& r) { return &L.phi[(r.tile*npt + r.node0)*nc]; };
+    auto pack = [&](const std::vector<std::vector<nodeRun>>& runs) {
+        std::vector<std::vector<double>> send(P);
+        for (int r = 0; r < P; ++r)
+            for (const nodeRun& run : runs[r]) send[r].insert(send[r].end(), at(run), at(run) + run.nodes*nc);
+        return send;
+    };
+    const std::vector<std::vector<double>> partials = comm_.exchange(pack(X.partialTo));
+    std::vector<double>& sum = chunkSum_;
+    for (std::size_t k = 0; k < X.owned.size(); ++k)
+    {
+        const std::size_t n = std::size_t(X.owned[k].nodes)*nc;
+        double* ph = at(X.owned[k]);
+        sum.assign(n, 0.0);
+        for (std::int64_t t = X.termsBegin[k]; t < X.termsBegin[k + 1]; ++t)
+        {
+            const int r = X.terms[t].first;
+            const double* v = r == me ? ph : &partials[r][X.terms[t].second];
+            for (std::size_t j = 0; j < n; ++j) sum[j] += v[j];
+        }
+        std::copy(sum.begin(), sum.end(), ph);
+    }
+    const std::vector<std::vector<double>> full = comm_.exchange(pack(X.fullTo));
+    for (int r = 0; r < P; ++r)
+    {
+        const double* v = full[r].data();
+        for (const nodeRun& run : X.fullFrom[r])
+        {
+            std::copy(v, v + run.nodes*nc, at(run));
+            v += run.nodes*nc;
+        }
     }
 }
 

@@ -25,6 +25,7 @@ class levelApplier
     std::vector<double> scaledResiduals_;   ///< r/sum(w^2) per point x component (levels not separated)
     std::vector<double> levelValues_;       ///< the current level's values at the control points, in order
     std::vector<double> setAside_;          ///< own partial sums of the tiles shared with lower ranks
+    std::vector<double> chunkSum_;          ///< one chunk's sum (chunked exchange)
 
     void clearLattice(levelPlan<D>& L) const;
     void computeStencils(const levelPlan<D>& L);
@@ -33,6 +34,7 @@ class levelApplier
     void exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals);
     std::vector<double> ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got) const;
     void addInRankOrder(levelPlan<D>& L, const std::vector<std::vector<double>>& got);
+    void exchangeChunks(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L) const;
     void subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals);
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace mba {
 
@@ -58,6 +59,7 @@ class levelPlanner
     const controlPoints<D>& ctrl_;      ///< this rank's control points
     const queryClusters<D>& clusters_;  ///< this rank's query points (parallel only)
     const int bucketTiles_;             ///< target tiles per bucket (params::bucketTiles)
+    const params::exchangeMode mode_;   ///< how the partial sums meet (params::exchange)
     const int nRanks_, me_;             ///< the communicator's size and this rank
     const int nc_, omegaPerNode_;       ///< values a point, omega values a node (as ctrl_'s)
 
@@ -68,6 +70,7 @@ class levelPlanner
     hugeVector<double> ownOmega_;       ///< this rank's partial omega on its own tiles (may become the view's)
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
+    std::vector<std::int64_t> ownToView_;              ///< own tile id -> view id (parallel)
 
     void ownTilesAndOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
@@ -80,13 +83,15 @@ class levelPlanner
     void findControlTiles();
     void testSeparation();
     void findGhostTiles();
+    chunkExchange planChunks() const;
+    void chooseExchange();
     void fillStats();
 
 public:
     levelPlanner(const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                 const queryClusters<D>& clusters, int bucketTiles)
+                 const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
     :
-        comm_(comm), dom_(dom), ctrl_(ctrl), clusters_(clusters), bucketTiles_(bucketTiles),
+        comm_(comm), dom_(dom), ctrl_(ctrl), clusters_(clusters), bucketTiles_(bucketTiles), mode_(mode),
         nRanks_(comm.size()), me_(comm.rank()), nc_(ctrl.nComponents), omegaPerNode_(ctrl.omegaPerNode)
     {}
 
@@ -115,6 +120,7 @@ levelPlan<D> levelPlanner<D>::run(int k)
     testSeparation();
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
     findGhostTiles();
+    if (nRanks_ > 1) chooseExchange();
     L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
@@ -319,7 +325,8 @@ void levelPlanner<D>::assembleView()
         return;
     }
     L_.view.init(nodes_, dense);
-    std::vector<std::int64_t> ownToView(nOwn_);
+    ownToView_.resize(nOwn_);
+    std::vector<std::int64_t>& ownToView = ownToView_;
     for (std::int64_t id = 0; id < nOwn_; ++id) ownToView[id] = L_.view.findOrInsertKey(L_.ownLayout.keyOf(id));
     for (int r = 0; r < nRanks_; ++r)
         for (auto key : keysFrom_[r]) L_.tilesFrom[r].push_back(L_.view.findOrInsertKey(key));
@@ -414,6 +421,113 @@ void levelPlanner<D>::findGhostTiles()
     for (const auto& g : L_.ghostTiles) L_.hasGhosts = L_.hasGhosts || !g.empty();
 }
 
+/// The chunked exchange (chunkExchange). Every rank that holds a tile in
+/// its view reads it, and asked every contributor for it: each knows the
+/// tile's contributors, hence every chunk's owner, and each owner knows the
+/// tile's readers (the ranks that asked it).
+template <int D>
+chunkExchange levelPlanner<D>::planChunks() const
+{
+    const std::int64_t nView = L_.view.size();
+    // contributors of each view tile (CSR), in rank order; the readers of own tiles
+    std::vector<std::int64_t> cBegin(nView + 1, 0), rBegin(nView + 1, 0);
+    auto forContributors = [&](const std::function<void(std::int64_t, int)>& f) {
+        for (int r = 0; r < nRanks_; ++r)
+        {
+            if (r == me_) for (const std::int64_t id : ownToView_) f(id, r);
+            else for (const std::int64_t id : L_.tilesFrom[r]) f(id, r);
+        }
+    };
+    auto forReaders = [&](const std::function<void(std::int64_t, int)>& f) {
+        for (int r = 0; r < nRanks_; ++r) for (const std::int64_t id : L_.tilesTo[r]) f(id, r);
+    };
+    forContributors([&](std::int64_t id, int) { ++cBegin[id + 1]; });
+    forReaders([&](std::int64_t id, int) { ++rBegin[id + 1]; });
+    for (std::int64_t id = 0; id < nView; ++id) { cBegin[id + 1] += cBegin[id]; rBegin[id + 1] += rBegin[id]; }
+    std::vector<int> contributors(cBegin[nView]), readers(rBegin[nView]);
+    {
+        std::vector<std::int64_t> cAt(cBegin.begin(), cBegin.end() - 1), rAt(rBegin.begin(), rBegin.end() - 1);
+        forContributors([&](std::int64_t id, int r) { contributors[cAt[id]++] = r; });
+        forReaders([&](std::int64_t id, int r) { readers[rAt[id]++] = r; });
+    }
+    std::vector<std::int64_t> byKey;
+    for (std::int64_t id = 0; id < nView; ++id) if (cBegin[id + 1] > cBegin[id]) byKey.push_back(id);
+    std::sort(byKey.begin(), byKey.end(), [&](std::int64_t a, std::int64_t b) {
+        return L_.view.keyOf(a) < L_.view.keyOf(b);
+    });
+
+    chunkExchange X;
+    X.partialTo.assign(nRanks_, {});
+    X.fullTo.assign(nRanks_, {});
+    X.fullFrom.assign(nRanks_, {});
+    X.termsBegin.push_back(0);
+    std::vector<std::int64_t> offset(nRanks_, 0);   // values from each rank in round 1 so far
+    for (const std::int64_t id : byKey)
+    {
+        const int* C = &contributors[cBegin[id]];
+        const std::int64_t m = cBegin[id + 1] - cBegin[id];
+        const bool own = std::find(C, C + m, me_) != C + m;
+        const std::int64_t nChunks = std::min<std::int64_t>(m, npt), rot = std::int64_t(L_.view.keyOf(id) % m);
+        for (std::int64_t j = 0; j < nChunks; ++j)
+        {
+            const nodeRun run{id, std::int32_t(j*npt/nChunks), std::int32_t((j + 1)*npt/nChunks - j*npt/nChunks)};
+            const int owner = C[(j + rot) % m];
+            if (owner != me_)
+            {
+                if (own) X.partialTo[owner].push_back(run);
+                X.fullFrom[owner].push_back(run);
+                continue;
+            }
+            X.owned.push_back(run);
+            for (std::int64_t c = 0; c < m; ++c)
+            {
+                X.terms.emplace_back(C[c], C[c] == me_ ? -1 : offset[C[c]]);
+                if (C[c] != me_) offset[C[c]] += std::int64_t(run.nodes)*nc_;
+            }
+            X.termsBegin.push_back(std::int64_t(X.terms.size()));
+            for (std::int64_t q = rBegin[id]; q < rBegin[id + 1]; ++q) X.fullTo[readers[q]].push_back(run);
+        }
+    }
+    return X;
+}
+
+/// Values (nc a node) of runs
+inline std::int64_t runValues(const std::vector<nodeRun>& runs, int nc)
+{
+    std::int64_t n = 0;
+    for (const nodeRun& r : runs) n += std::int64_t(r.nodes)*nc;
+    return n;
+}
+
+/// Direct or chunked (params::exchange): automatic takes the chunks when
+/// the rank that receives most per apply then receives fewer bytes. A
+/// separated level stays direct (its apply stores phi where it is read).
+template <int D>
+void levelPlanner<D>::chooseExchange()
+{
+    if (mode_ == params::exchangeMode::direct || L_.separated) return;
+    chunkExchange X = planChunks();
+    if (mode_ == params::exchangeMode::automatic)
+    {
+        std::int64_t direct = 0, chunked = 0;
+        for (int r = 0; r < nRanks_; ++r)
+        {
+            direct += L_.ghostTiles[r].empty() ? std::int64_t(L_.tilesFrom[r].size())*npt*nc_
+                : std::int64_t(L_.ghostTiles[r].size())*nc_;
+            chunked += runValues(X.fullFrom[r], nc_);
+        }
+        for (std::size_t k = 0; k < X.owned.size(); ++k)
+            chunked += (X.termsBegin[k + 1] - X.termsBegin[k] - 1)*std::int64_t(X.owned[k].nodes)*nc_;
+        if (!(comm_.max(double(chunked)) < comm_.max(double(direct)))) return;
+    }
+    L_.chunked = true;
+    L_.chunks = std::move(X);
+    L_.ghostsTo.assign(nRanks_, {});
+    L_.ghostsFrom.assign(nRanks_, {});
+    L_.ghostTiles.assign(nRanks_, {});
+    L_.hasGhosts = false;
+}
+
 template <int D>
 void levelPlanner<D>::fillStats()
 {
@@ -425,11 +539,43 @@ void levelPlanner<D>::fillStats()
     s.viewTiles = L.view.size();
     s.dense = L.view.dense();
     s.separated = L.separated;
+    s.chunked = L.chunked;
     s.nodes = L.view.size()*npt;
     s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
         + L.scaledResiduals.capacity()*sizeof(double));
+    if (L.chunked)
+    {
+        const chunkExchange& X = L.chunks;
+        std::int64_t partialsIn = 0;
+        std::vector<std::uint8_t> from(nRanks_, 0);
+        for (std::size_t k = 0; k < X.owned.size(); ++k)
+            for (std::int64_t t = X.termsBegin[k]; t < X.termsBegin[k + 1]; ++t)
+                if (X.terms[t].first != me_)
+                {
+                    partialsIn += std::int64_t(X.owned[k].nodes)*nc_;
+                    from[X.terms[t].first] = 1;
+                }
+        for (int r = 0; r < nRanks_; ++r)
+        {
+            const std::int64_t out = runValues(X.partialTo[r], nc_) + runValues(X.fullTo[r], nc_);
+            const std::int64_t in = runValues(X.fullFrom[r], nc_);
+            s.messagesSent += !X.partialTo[r].empty() + !X.fullTo[r].empty();
+            s.messagesReceived += from[r] + !X.fullFrom[r].empty();
+            s.bytesSentPerApply += out*std::int64_t(sizeof(double));
+            s.bytesReceivedPerApply += in*std::int64_t(sizeof(double));
+            s.tilesSent += std::int64_t(L.tilesTo[r].size());
+            s.tilesReceived += std::int64_t(L.tilesFrom[r].size());
+        }
+        s.bytesReceivedPerApply += partialsIn*std::int64_t(sizeof(double));
+        s.bytes += std::int64_t(X.terms.capacity()*sizeof(X.terms[0]) + X.termsBegin.capacity()*sizeof(std::int64_t)
+            + X.owned.capacity()*sizeof(nodeRun));
+        for (int r = 0; r < nRanks_; ++r)
+            s.bytes += std::int64_t((X.partialTo[r].capacity() + X.fullTo[r].capacity() + X.fullFrom[r].capacity())
+                *sizeof(nodeRun));
+        return;
+    }
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
     {
         s.tilesSent += std::int64_t(L.tilesTo[r].size());
@@ -453,16 +599,16 @@ void levelPlanner<D>::fillStats()
 
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles)
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
 {
-    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles).run(k);
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode).run(k);
 }
 
 template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
 template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
-                                   const queryClusters<2>&, int);
+                                   const queryClusters<2>&, int, params::exchangeMode);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
-                                   const queryClusters<3>&, int);
+                                   const queryClusters<3>&, int, params::exchangeMode);
 
 } // namespace mba

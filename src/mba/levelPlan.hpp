@@ -38,6 +38,34 @@ struct queryClusters
 template <int D>
 queryClusters<D> clusterQueryPoints(const communicator& comm, const controlPoints<D>& ctrl, pointsView<D> eval);
 
+/// A run of nodes of a view tile: nodes x nc values from phi[(tile*npt + node0)*nc]
+struct nodeRun
+{
+    std::int64_t tile;
+    std::int32_t node0, nodes;
+};
+
+/// The chunked exchange of a level (params::exchange). Each tile with
+/// contributors C (sorted ranks) is split into min(|C|, npt) chunks of
+/// nodes; chunk j belongs to C[(j + key) mod |C|]. Round 1: every
+/// contributor sends its partial sums on the chunks of its tiles that
+/// others own to their owners; each owner sums its chunks in rank order.
+/// Round 2: each owner sends its summed chunks to every other rank that
+/// reads the tile. Both sides list a message's runs in tile-key order,
+/// chunks in order.
+struct chunkExchange
+{
+    std::vector<std::vector<nodeRun>> partialTo; ///< per rank: own partial sums it sums (round 1)
+    std::vector<nodeRun> owned;                  ///< the chunks this rank sums
+    std::vector<std::int64_t> termsBegin;        ///< per owned chunk: its terms in terms (CSR, owned.size() + 1)
+    /// per owned chunk, its contributors in rank order: (rank, offset of its
+    /// values in the round-1 message from that rank); this rank: (rank, -1),
+    /// its partial sums in phi
+    std::vector<std::pair<std::int32_t, std::int64_t>> terms;
+    std::vector<std::vector<nodeRun>> fullTo;    ///< per rank: summed chunks sent to it (round 2)
+    std::vector<std::vector<nodeRun>> fullFrom;  ///< per rank: summed chunks it sends here
+};
+
 template <int D>
 struct levelPlan
 {
@@ -80,6 +108,9 @@ struct levelPlan
     std::vector<std::vector<stencilTiles<D>>> ghostTiles; ///< per rank: its ghosts' tiles, as positions in tilesFrom
     bool hasGhosts = false;         ///< this rank sends or receives ghosts at this level
 
+    bool chunked = false;           ///< the partial sums meet in chunks (chunks), not directly
+    chunkExchange chunks;
+
     levelStats stats;
 
     /// The layout of the own tiles
@@ -89,7 +120,7 @@ struct levelPlan
 /// Plans level k. Collective.
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles);
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode);
 
 } // namespace mba
 #endif

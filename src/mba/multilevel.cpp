@@ -231,7 +231,8 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         if (k == int(s.levels.size()))
         {
             const double t1 = now();
-            s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles));
+            s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
+                                            s.parameters.exchange));
             s.levels.back().stats.planSeconds = now() - t1;
         }
         const double t1 = now();

@@ -13,16 +13,38 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-enum class partition { slabs, random };
+enum class partition { slabs, random, boxes };
 
-/// Rank of point i: slabs along x, or seeded random
+const char* name(partition how)
+{
+    return how == partition::slabs ? "slabs" : how == partition::random ? "random" : "boxes";
+}
+
+/// Parts per direction of box-shaped ranks: the most even a >= b (>= c) with a b (c) = P
+template <int D>
+std::array<int, 3> boxParts(int P)
+{
+    std::array<int, 3> best{P, 1, 1};
+    for (int c = 1; D == 3 ? c*c*c <= P : c == 1; ++c)
+        for (int b = c; P % c == 0 && b*b <= P/c; ++b)
+            if ((P/c) % b == 0 && P/c/b - c < best[0] - best[2]) best = {P/c/b, b, c};
+    return best;
+}
+
+/// Rank of point i: slabs along x, boxes (boxParts), or seeded random
 template <int D>
 std::vector<int> ranksOf(const std::vector<point<D>>& x, int P, partition how, unsigned seed)
 {
     std::vector<int> r(x.size());
     std::mt19937 rng(seed);
+    const std::array<int, 3> m = boxParts<D>(P);
     for (std::size_t i = 0; i < x.size(); ++i)
-        r[i] = how == partition::slabs ? std::min(P - 1, int(x[i][0]*P)) : int(rng() % unsigned(P));
+    {
+        if (how == partition::random) { r[i] = int(rng() % unsigned(P)); continue; }
+        if (how == partition::slabs) { r[i] = std::min(P - 1, int(x[i][0]*P)); continue; }
+        r[i] = 0;
+        for (int d = D - 1; d >= 0; --d) r[i] = r[i]*m[d] + std::min(m[d] - 1, int(x[i][d]*m[d]));
+    }
     return r;
 }
 
@@ -31,6 +53,7 @@ struct problem
     int nc = 3;
     params p;
     bool masked = false;
+    std::vector<std::vector<levelStats>>* stats = nullptr;   ///< per rank, when given
 };
 
 /// Values at every evaluation point (global order) from P ranks
@@ -61,6 +84,7 @@ std::vector<double> solve(int P, partition how, const std::vector<point<D>>& c, 
         m.fit(vl);   // a second apply through the plan
         std::vector<double> o;
         m.evaluate(o);
+        if (pb.stats) (*pb.stats)[comm.rank()] = m.stats();
         for (std::size_t j = 0; j < eg.size(); ++j)
             for (int k = 0; k < pb.nc; ++k) out[eg[j]*pb.nc + k] = o[j*pb.nc + k];   // disjoint writes
     });
@@ -83,7 +107,7 @@ void serialEqualsRanks(bool affine, bool masked, partition how)
     for (int P : {2, 3, 5, 8})
     {
         INFO("D " << D << ", ranks " << P << ", affine " << affine << ", masked " << masked
-             << ", partition " << (how == partition::slabs ? "slabs" : "random"));
+             << ", partition " << name(how));
         const std::vector<double> got = solve<D>(P, how, c, v, mask, e, pb);
         double diff = 0;
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
@@ -108,9 +132,74 @@ TEST_CASE("serial equals simulated ranks", "[parallel]")
 {
     const bool affine = GENERATE(true, false);
     const bool masked = GENERATE(false, true);
-    const partition how = GENERATE(partition::slabs, partition::random);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
     serialEqualsRanks<2>(affine, masked, how);
     serialEqualsRanks<3>(affine, masked, how);
+}
+
+TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and serial's", "[parallel][chunks]")
+{
+    // a surface (the morphing case) and scattered points
+    const bool masked = GENERATE(false, true);
+    const bool surface = GENERATE(true, false);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    const auto c = surface ? surfacePoints<3>(14) : randomPoints<3>(1500, 75);
+    const auto e = randomPoints<3>(1500, 73);
+    problem pb;
+    pb.p.tolerance = 1e-9;
+    pb.p.bucketTiles = 8;
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
+    const std::vector<double> ref = solve<3>(1, how, c, v, mask, e, pb);
+    for (const int P : {2, 3, 5, 8, 16})
+    {
+        INFO("ranks " << P << ", masked " << masked << ", surface " << surface << ", partition " << name(how));
+        std::vector<std::vector<levelStats>> st(P);
+        pb.stats = &st;
+        pb.p.exchange = params::exchangeMode::chunked;
+        const std::vector<double> chunked = solve<3>(P, how, c, v, mask, e, pb);
+        pb.p.exchange = params::exchangeMode::direct;
+        pb.stats = nullptr;
+        const std::vector<double> direct = solve<3>(P, how, c, v, mask, e, pb);
+        int chunkedLevels = 0;
+        for (const levelStats& s : st[0]) chunkedLevels += s.chunked;
+        CHECK(chunkedLevels >= 4);
+        std::size_t differ = 0;
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i)
+        {
+            differ += !(chunked[i] == direct[i]);
+            diff = std::max(diff, std::abs(chunked[i] - ref[i]));
+        }
+        CHECK(differ == 0);
+        CHECK(diff <= 1e-12*maxAbs(v));
+    }
+}
+
+TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many ranks share it", "[parallel][chunks]")
+{
+    // level 0 is one tile that every rank contributes to and reads: directly
+    // each rank receives P - 1 tiles; in chunks its partial sums of one chunk
+    // from each other rank, then the other chunks summed (two tiles at most)
+    const auto c = surfacePoints<3>(20);
+    const auto e = randomPoints<3>(3000, 74);
+    const auto v = smoothValues<3>(c, 3);
+    const std::int64_t tile = tileLayout<3>::nodesPerTile*3*std::int64_t(sizeof(double));
+    for (const int P : {4, 8, 16})
+    {
+        problem pb;
+        pb.p.tolerance = 1e-8;
+        std::vector<std::vector<levelStats>> st(P);
+        pb.stats = &st;
+        solve<3>(P, partition::slabs, c, v, {}, e, pb);
+        for (int r = 0; r < P; ++r)
+        {
+            INFO(P << " ranks, rank " << r);
+            REQUIRE(st[r][0].chunked);
+            CHECK(st[r][0].bytesReceivedPerApply <= 2*tile);
+            CHECK(st[r][0].bytesReceivedPerApply >= tile*(P - 1)/P);
+        }
+    }
 }
 
 TEST_CASE("levels that separate the control points: serial equals simulated ranks", "[parallel]")
@@ -139,7 +228,7 @@ TEST_CASE("levels that separate the control points: serial equals simulated rank
     const std::vector<double> ref = solve<3>(1, how, c, v, mask, e, pb);
     for (int P : {2, 3, 5})
     {
-        INFO("ranks " << P << ", masked " << masked << ", partition " << (how == partition::slabs ? "slabs" : "random"));
+        INFO("ranks " << P << ", masked " << masked << ", partition " << name(how));
         const std::vector<double> got = solve<3>(P, how, c, v, mask, e, pb);
         double diff = 0;
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
@@ -264,6 +353,7 @@ TEST_CASE("fine levels exchange ghost residuals, not tiles; coarse levels tiles"
     params p;
     p.tolerance = 1e-8;
     p.maxLevels = 9;
+    p.exchange = params::exchangeMode::direct;
     for (const int P : {2, 4, 8})
     {
         const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);

@@ -1,0 +1,310 @@
+// mbaScaling: per-rank communication and work of the distributed multilevel
+// B-spline core on the twisted cube, on simulated ranks (OpenFOAM-free).
+//
+//   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical]
+//              [--levels]
+//
+// The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
+// cells (default 100: 1M cells), its (N+1)^3 points. The control points are
+// those of the fixed bottom and of the top, turned by 0.5 rad about the
+// vertical axis and indented by a sphere (radius 0.3, depth 0.15): 3
+// components each. The sides and the interior are evaluated. The cells are
+// split as decomposePar splits this mesh: `simple` in P slabs along x (n (P 1
+// 1)), `hierarchical` in a x b x c boxes (a >= b >= c, as near equal as P
+// allows). A point on a processor boundary is held by every rank whose cells
+// it touches (each evaluates it); a control point belongs to the lowest of
+// them, as the motion solver counts it.
+//
+// Per rank count: the plan and a first fit, then one step measured (a fit
+// through the plan with new values, and the evaluation). Per rank: its control
+// and evaluation points, its neighbours (ranks it shares points with), what it
+// receives point-to-point in the step (bytes, messages), what the step's
+// collectives cost it, and the CPU time of its fit and evaluation (thread CPU
+// time: each simulated rank's own work, whatever the cores). Prints a table per
+// rank count and one RESULT line each (key=value), which benchmarks/scaling
+// reads; --levels adds the per-level exchange of the rank that receives most.
+
+#include "multilevel.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <string>
+
+using namespace mba;
+
+namespace {
+
+struct options
+{
+    long n = 100;
+    std::vector<int> ranks{1, 2, 4, 8, 16, 32, 64};
+    std::string decomposition = "simple";
+    bool levels = false;
+};
+
+[[noreturn]] void usage(const std::string& msg)
+{
+    std::cerr << "mbaScaling: " << msg << "\n"
+        "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical] [--levels]\n";
+    std::exit(2);
+}
+
+options parse(int argc, char** argv)
+{
+    options o;
+    for (int i = 1; i < argc; ++i)
+    {
+        const std::string a = argv[i];
+        auto val = [&]() -> std::string {
+            if (i + 1 >= argc) usage("missing value for " + a);
+            return argv[++i];
+        };
+        try
+        {
+            if (a == "--n") o.n = std::stol(val());
+            else if (a == "--ranks")
+            {
+                o.ranks.clear();
+                std::istringstream is(val());
+                for (int p; is >> p;) o.ranks.push_back(p);
+            }
+            else if (a == "--decomposition") o.decomposition = val();
+            else if (a == "--levels") o.levels = true;
+            else usage("unknown option " + a);
+        }
+        catch (const std::logic_error&) { usage("bad value for " + a); }
+    }
+    if (o.decomposition != "simple" && o.decomposition != "hierarchical")
+        usage("--decomposition must be simple or hierarchical");
+    if (o.n < 2) usage("--n must be at least 2");
+    for (int p : o.ranks) if (p < 1 || p > o.n) usage("every rank count must be in [1, n]");
+    if (o.ranks.empty()) usage("--ranks needs at least one rank count");
+    return o;
+}
+
+/// Parts per direction: (P 1 1), or the most even a >= b >= c with a b c = P
+std::array<int, 3> parts(int P, const std::string& how)
+{
+    if (how == "simple") return {P, 1, 1};
+    std::array<int, 3> best{P, 1, 1};
+    for (int c = 1; c*c*c <= P; ++c)
+    {
+        if (P % c) continue;
+        for (int b = c; b*b <= P/c; ++b)
+        {
+            if ((P/c) % b) continue;
+            const int a = P/c/b;
+            if (a - c < best[0] - best[2]) best = {a, b, c};
+        }
+    }
+    return best;
+}
+
+double threadSeconds()
+{
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9*double(t.tv_nsec);
+}
+
+/// The twisted cube's top and bottom at t = 1: displacement of the point x
+point<3> displacement(const point<3>& x)
+{
+    point<3> d{0, 0, 0};
+    if (x[2] < 0.5) return d;
+    const double a = 0.5, c = std::cos(a), s = std::sin(a);
+    const double dx = x[0] - 0.5, dy = x[1] - 0.5;
+    point<3> y{0.5 + c*dx - s*dy, 0.5 + s*dx + c*dy, x[2]};
+    // the sphere (centre 1.15 above the axis, radius 0.3) pushes points down onto it
+    const double rx = y[0] - 0.5, ry = y[1] - 0.5, r2 = rx*rx + ry*ry;
+    if (r2 < 0.09) y[2] = std::min(y[2], 1.15 - std::sqrt(0.09 - r2));
+    for (int k = 0; k < 3; ++k) d[k] = y[k] - x[k];
+    return d;
+}
+
+/// One rank's figures of the measured step
+struct rankFigures
+{
+    double control = 0, evaluation = 0, neighbours = 0;
+    double bytes = 0, messages = 0, collectiveBytes = 0, collectives = 0;
+    double fitCpu = 0, evalCpu = 0, planCpu = 0;
+};
+
+/// First index of part p of n cells in m parts, and the point range of the part
+long first(int p, long n, int m) { return long(p)*n/m; }
+
+struct rankResult
+{
+    std::vector<rankFigures> ranks;
+    std::vector<levelStats> busiestLevels;   ///< the levels of the rank that receives most
+    int levels = 0;
+    double maxResidual = 0;
+};
+
+rankResult runRanks(const options& o, int P)
+{
+    const std::array<int, 3> m = parts(P, o.decomposition);
+    const long n = o.n;
+    params prm;   // the motion solver's defaults
+    rankResult res;
+    res.ranks.resize(P);
+    std::mutex mtx;
+    runSimulated(P, [&](const communicator& comm) {
+        const int r = comm.rank();
+        const std::array<int, 3> pr{r % m[0], (r/m[0]) % m[1], r/(m[0]*m[1])};
+        std::array<long, 3> lo, hi;
+        for (int d = 0; d < 3; ++d) { lo[d] = first(pr[d], n, m[d]); hi[d] = first(pr[d] + 1, n, m[d]); }
+        // the lowest rank holding point index i in direction d: the part before when i starts this part
+        auto lowestOwner = [&](const std::array<long, 3>& i) {
+            std::array<int, 3> q = pr;
+            for (int d = 0; d < 3; ++d) if (i[d] == lo[d] && pr[d] > 0) --q[d];
+            return q[0] + m[0]*(q[1] + m[1]*q[2]);
+        };
+        std::vector<point<3>> ctrl, eval;
+        std::vector<double> v1, v2;
+        for (long k = lo[2]; k <= hi[2]; ++k)
+            for (long j = lo[1]; j <= hi[1]; ++j)
+                for (long i = lo[0]; i <= hi[0]; ++i)
+                {
+                    const point<3> x{double(i)/n, double(j)/n, double(k)/n};
+                    if (k != 0 && k != n) { eval.push_back(x); continue; }
+                    if (lowestOwner({i, j, k}) != r) continue;
+                    ctrl.push_back(x);
+                    const point<3> d = displacement(x);
+                    for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }
+                }
+        std::set<int> nb;
+        for (int q = 0; q < P; ++q)
+        {
+            const std::array<int, 3> pq{q % m[0], (q/m[0]) % m[1], q/(m[0]*m[1])};
+            bool touch = q != r;
+            for (int d = 0; d < 3; ++d) touch = touch && std::abs(pq[d] - pr[d]) <= 1;
+            if (touch) nb.insert(q);
+        }
+
+        rankFigures f;
+        f.control = double(ctrl.size());
+        f.evaluation = double(eval.size());
+        f.neighbours = double(nb.size());
+        double t = threadSeconds();
+        multilevel<3> mba(comm, prm, 3, pointsView<3>(ctrl.empty() ? nullptr : ctrl[0].data(), ctrl.size()), {},
+                          pointsView<3>(eval.empty() ? nullptr : eval[0].data(), eval.size()));
+        mba.fit(v1);
+        std::vector<double> out;
+        mba.evaluate(out);
+        f.planCpu = threadSeconds() - t;
+
+        // the step: a fit through the plan, the evaluation
+        const trafficStats before = comm.traffic();
+        t = threadSeconds();
+        const fitReport& rep = mba.fit(v2);
+        f.fitCpu = threadSeconds() - t;
+        t = threadSeconds();
+        mba.evaluate(out);
+        f.evalCpu = threadSeconds() - t;
+        const trafficStats after = comm.traffic();
+        f.bytes = double(after.bytesReceived - before.bytesReceived);
+        f.messages = double(after.messagesReceived - before.messagesReceived);
+        f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes);
+
+        std::lock_guard<std::mutex> lock(mtx);
+        res.ranks[r] = f;
+        res.levels = rep.levels;
+        res.maxResidual = rep.maxResidual;
+        const bool busiest = std::none_of(res.ranks.begin(), res.ranks.end(),
+                                          [&](const rankFigures& g) { return g.bytes > f.bytes; });
+        if (busiest) res.busiestLevels = mba.stats();
+    });
+    return res;
+}
+
+struct summary
+{
+    double max = 0, mean = 0;
+};
+
+template <class F>
+summary over(const std::vector<rankFigures>& v, F get)
+{
+    summary s;
+    for (const auto& f : v) { s.max = std::max(s.max, get(f)); s.mean += get(f)/double(v.size()); }
+    return s;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    const options o = parse(argc, argv);
+    const long n = o.n;
+    const long nControl = 2*(n + 1)*(n + 1);
+    std::printf("mbaScaling: twisted cube, %ld^3 cells, %ld control points (top and bottom), %ld evaluated points, "
+                "decomposition %s\n", n, nControl, (n + 1)*(n + 1)*(n + 1) - nControl, o.decomposition.c_str());
+    std::printf("per step (a fit through the plan and the evaluation); share: 48 bytes per control point of the "
+                "rank's mean share of the boundary\n\n");
+    std::printf("%5s %9s %8s %8s %11s %11s %8s %6s %6s %5s %9s %9s %9s %9s %8s\n", "ranks", "parts", "ctrl max",
+                "nbrs max", "recv max B", "recv mean B", "max/shr", "msg mx", "msg mn", "lvls", "fit cpu mx",
+                "fit mean", "eval mx", "eval mean", "imbal");
+    try
+    {
+        for (const int P : o.ranks)
+        {
+            const rankResult res = runRanks(o, P);
+            const std::vector<rankFigures>& v = res.ranks;
+            const std::array<int, 3> m = parts(P, o.decomposition);
+            const summary ctrl = over(v, [](const rankFigures& f) { return f.control; });
+            const summary eval = over(v, [](const rankFigures& f) { return f.evaluation; });
+            const summary nb = over(v, [](const rankFigures& f) { return f.neighbours; });
+            const summary bytes = over(v, [](const rankFigures& f) { return f.bytes; });
+            const summary msgs = over(v, [](const rankFigures& f) { return f.messages; });
+            const summary coll = over(v, [](const rankFigures& f) { return f.collectiveBytes; });
+            const summary fit = over(v, [](const rankFigures& f) { return f.fitCpu; });
+            const summary ev = over(v, [](const rankFigures& f) { return f.evalCpu; });
+            const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
+            const summary plan = over(v, [](const rankFigures& f) { return f.planCpu; });
+            // messages per neighbour and level: the bound the exchange keeps
+            const summary perNb = over(v, [&](const rankFigures& f) {
+                return f.neighbours > 0 ? f.messages/(f.neighbours*res.levels) : 0.0;
+            });
+            const double share = 48.0*double(nControl)/P;
+            const std::string pstr = std::to_string(m[0]) + "x" + std::to_string(m[1]) + "x" + std::to_string(m[2]);
+            std::printf("%5d %9s %8.0f %8.0f %11.0f %11.0f %8.2f %6.0f %6.1f %5d %9.4f %9.4f %9.4f %9.4f %8.2f\n",
+                        P, pstr.c_str(), ctrl.max, nb.max, bytes.max, bytes.mean, bytes.max/share, msgs.max,
+                        msgs.mean, res.levels, fit.max, fit.mean, ev.max, ev.mean, work.max/work.mean);
+            std::printf("RESULT n=%ld decomposition=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
+                        "ctrl_mean=%.1f eval_max=%.0f eval_mean=%.1f neighbours_max=%.0f recv_bytes_max=%.0f "
+                        "recv_bytes_mean=%.1f share_bytes=%.1f messages_max=%.0f messages_mean=%.2f "
+                        "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f fit_cpu_max=%.6f "
+                        "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
+                        "plan_cpu_max=%.4f max_residual=%.3e\n",
+                        n, o.decomposition.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
+                        eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
+                        coll.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
+                        res.maxResidual);
+            if (o.levels)
+            {
+                std::printf("  levels of the rank receiving most: level, tiles received, ghosts received, "
+                            "messages, bytes received\n");
+                for (const levelStats& s : res.busiestLevels)
+                    std::printf("  %5d %8lld %8lld %4lld %10lld\n", s.level, static_cast<long long>(s.tilesReceived),
+                                static_cast<long long>(s.ghostsReceived), static_cast<long long>(s.messagesReceived),
+                                static_cast<long long>(s.bytesReceivedPerApply));
+            }
+            std::fflush(stdout);
+        }
+    }
+    catch (const std::exception& e)
+    {
+        std::cerr << "mbaScaling: error: " << e.what() << std::endl;
+        return 1;
+    }
+    return 0;
+}
