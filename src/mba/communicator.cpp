@@ -36,6 +36,17 @@ std::int64_t communicator::sum(std::int64_t x) const
     return s;
 }
 
+std::vector<bytes> communicator::exchangeKnownBytes(const std::vector<bytes>& send,
+                                                  const std::vector<std::size_t>& recvSizes) const
+{
+    std::vector<bytes> got = exchangeBytes(send);
+    for (std::size_t r = 0; r < got.size(); ++r)
+        if (got[r].size() != recvSizes[r])
+            throw std::logic_error("mba: rank " + std::to_string(rank()) + " expected " + std::to_string(recvSizes[r])
+                                   + " bytes from rank " + std::to_string(r) + ", got " + std::to_string(got[r].size()));
+    return got;
+}
+
 void communicator::check(bool ok, const std::string& msg) const
 {
     bytes mine;

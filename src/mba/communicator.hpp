@@ -42,6 +42,11 @@ protected:
     virtual std::vector<bytes> allGatherBytes(const bytes& mine) const = 0;
     /// send[r] goes to rank r (empty: no message); returns what rank r sent here
     virtual std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const = 0;
+    /// The same when this rank knows what each rank sends it (recvSizes[r]
+    /// bytes; 0: no message), as in every apply of a plan: no sizes need to
+    /// travel. By default exchangeBytes, with the sizes checked.
+    virtual std::vector<bytes> exchangeKnownBytes(const std::vector<bytes>& send,
+                                                  const std::vector<std::size_t>& recvSizes) const;
 
 public:
     virtual ~communicator() = default;
@@ -66,27 +71,16 @@ public:
     template <class T>
     std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send) const
     {
-        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
-        std::vector<bytes> b(size());
-        for (int r = 0; r < size(); ++r)
-        {
-            if (r >= int(send.size()) || send[r].empty()) continue;
-            b[r].resize(send[r].size()*sizeof(T));
-            std::memcpy(b[r].data(), send[r].data(), b[r].size());
-            if (r != rank()) { ++traffic_.messagesSent; traffic_.bytesSent += b[r].size(); }
-        }
-        const std::vector<bytes> got = exchangeBytes(b);
-        std::vector<std::vector<T>> out(got.size());
-        for (std::size_t r = 0; r < got.size(); ++r)
-        {
-            if (!got[r].empty() && int(r) != rank())
-            {
-                ++traffic_.messagesReceived;
-                traffic_.bytesReceived += got[r].size();
-            }
-            out[r] = fromBytes<T>(got[r]);
-        }
-        return out;
+        return exchangeAs<T>(send, nullptr);
+    }
+
+    /// exchange when this rank knows how many values each rank sends it
+    /// (recvCounts[r]; the plan of an apply does): no sizes travel
+    template <class T>
+    std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send,
+                                         const std::vector<std::size_t>& recvCounts) const
+    {
+        return exchangeAs<T>(send, &recvCounts);
     }
 
     /// Element-wise sum over ranks, added in rank order: identical on every rank
@@ -101,6 +95,41 @@ public:
     void check(bool ok, const std::string& msg) const;
 
 private:
+    template <class T>
+    std::vector<std::vector<T>> exchangeAs(const std::vector<std::vector<T>>& send,
+                                           const std::vector<std::size_t>* recvCounts) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        std::vector<bytes> b(size());
+        for (int r = 0; r < size(); ++r)
+        {
+            if (r >= int(send.size()) || send[r].empty()) continue;
+            b[r].resize(send[r].size()*sizeof(T));
+            std::memcpy(b[r].data(), send[r].data(), b[r].size());
+            if (r != rank()) { ++traffic_.messagesSent; traffic_.bytesSent += b[r].size(); }
+        }
+        std::vector<bytes> got;
+        if (recvCounts)
+        {
+            std::vector<std::size_t> sizes(size(), 0);
+            for (int r = 0; r < size() && r < int(recvCounts->size()); ++r) sizes[r] = (*recvCounts)[r]*sizeof(T);
+            sizes[rank()] = b[rank()].size();
+            got = exchangeKnownBytes(b, sizes);
+        }
+        else got = exchangeBytes(b);
+        std::vector<std::vector<T>> out(got.size());
+        for (std::size_t r = 0; r < got.size(); ++r)
+        {
+            if (!got[r].empty() && int(r) != rank())
+            {
+                ++traffic_.messagesReceived;
+                traffic_.bytesReceived += got[r].size();
+            }
+            out[r] = fromBytes<T>(got[r]);
+        }
+        return out;
+    }
+
     template <class T>
     static std::vector<T> fromBytes(const bytes& b)
     {

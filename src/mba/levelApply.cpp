@@ -253,7 +253,7 @@ void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<dou
         send[r].reserve(L.tilesTo[r].size()*blk);
         for (auto id : L.tilesTo[r]) send[r].insert(send[r].end(), &L.phi[id*blk], &L.phi[(id + 1)*blk]);
     }
-    std::vector<std::vector<double>> got = comm_.exchange(send);
+    std::vector<std::vector<double>> got = comm_.exchange(send, L.receiveCounts);
     for (int r = 0; r < P; ++r)
         if (!L.ghostTiles[r].empty()) got[r] = ghostPartialSums(L, r, got[r]);
     addInRankOrder(L, got);
@@ -349,7 +349,7 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
             for (const nodeRun& run : runs[r]) send[r].insert(send[r].end(), at(run), at(run) + run.nodes*nc);
         return send;
     };
-    const std::vector<std::vector<double>> partials = comm_.exchange(pack(X.partialTo));
+    const std::vector<std::vector<double>> partials = comm_.exchange(pack(X.partialTo), X.partialCounts);
     std::vector<double>& sum = chunkSum_;
     for (std::size_t k = 0; k < X.owned.size(); ++k)
     {
@@ -364,7 +364,7 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
         }
         std::copy(sum.begin(), sum.end(), ph);
     }
-    const std::vector<std::vector<double>> full = comm_.exchange(pack(X.fullTo));
+    const std::vector<std::vector<double>> full = comm_.exchange(pack(X.fullTo), X.fullCounts);
     for (int r = 0; r < P; ++r)
     {
         const double* v = full[r].data();

@@ -121,6 +121,9 @@ levelPlan<D> levelPlanner<D>::run(int k)
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
     findGhostTiles();
     if (nRanks_ > 1) chooseExchange();
+    L_.receiveCounts.assign(nRanks_, 0);
+    for (int r = 0; r < nRanks_ && nRanks_ > 1 && !L_.chunked; ++r)
+        L_.receiveCounts[r] = L_.ghostTiles[r].empty() ? L_.tilesFrom[r].size()*npt*nc_ : L_.ghostTiles[r].size()*nc_;
     L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
@@ -421,6 +424,14 @@ void levelPlanner<D>::findGhostTiles()
     for (const auto& g : L_.ghostTiles) L_.hasGhosts = L_.hasGhosts || !g.empty();
 }
 
+/// Values (nc a node) of runs
+inline std::int64_t runValues(const std::vector<nodeRun>& runs, int nc)
+{
+    std::int64_t n = 0;
+    for (const nodeRun& r : runs) n += std::int64_t(r.nodes)*nc;
+    return n;
+}
+
 /// The chunked exchange (chunkExchange). Every rank that holds a tile in
 /// its view reads it, and asked every contributor for it: each knows the
 /// tile's contributors, hence every chunk's owner, and each owner knows the
@@ -488,15 +499,9 @@ chunkExchange levelPlanner<D>::planChunks() const
             for (std::int64_t q = rBegin[id]; q < rBegin[id + 1]; ++q) X.fullTo[readers[q]].push_back(run);
         }
     }
+    X.partialCounts.assign(offset.begin(), offset.end());
+    for (int r = 0; r < nRanks_; ++r) X.fullCounts.push_back(std::size_t(runValues(X.fullFrom[r], nc_)));
     return X;
-}
-
-/// Values (nc a node) of runs
-inline std::int64_t runValues(const std::vector<nodeRun>& runs, int nc)
-{
-    std::int64_t n = 0;
-    for (const nodeRun& r : runs) n += std::int64_t(r.nodes)*nc;
-    return n;
 }
 
 /// Direct or chunked (params::exchange): automatic takes the chunks when

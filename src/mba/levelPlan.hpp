@@ -64,6 +64,8 @@ struct chunkExchange
     std::vector<std::pair<std::int32_t, std::int64_t>> terms;
     std::vector<std::vector<nodeRun>> fullTo;    ///< per rank: summed chunks sent to it (round 2)
     std::vector<std::vector<nodeRun>> fullFrom;  ///< per rank: summed chunks it sends here
+    std::vector<std::size_t> partialCounts;      ///< per rank: values it sends here in round 1
+    std::vector<std::size_t> fullCounts;         ///< per rank: values it sends here in round 2
 };
 
 template <int D>
@@ -98,6 +100,7 @@ struct levelPlan
 
     std::vector<std::vector<std::int64_t>> tilesTo;   ///< per rank: own tiles (view ids) whose partial sums it gets
     std::vector<std::vector<std::int64_t>> tilesFrom; ///< per rank: view tiles its partial sums arrive in
+    std::vector<std::size_t> receiveCounts;   ///< per rank: values it sends here per apply (direct exchange)
     /// Own tiles (view ids) that a lower rank also contributes to: this
     /// rank's partial sums there are set aside and added in rank order
     std::vector<std::int64_t> sharedWithLower;

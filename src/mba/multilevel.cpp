@@ -206,8 +206,15 @@ void multilevel<D>::state::residualStats(double& maxr, double& rms) const
         s[j & 3] += r*r;
     }
     const double n = all ? double(nv) : double(nv - std::count(mask.begin(), mask.end(), std::uint8_t(0)));
-    maxr = comm.max(std::max(std::max(m[0], m[1]), std::max(m[2], m[3])));
-    const std::vector<double> sn = comm.sum(std::vector<double>{(s[0] + s[1]) + (s[2] + s[3]), n});
+    // one all-gather for the maximum and the sums (added in rank order, as comm.sum)
+    maxr = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
+    double sn[2] = {0, 0};
+    for (const auto& v : comm.allGather(std::vector<double>{maxr, (s[0] + s[1]) + (s[2] + s[3]), n}))
+    {
+        maxr = std::max(maxr, v[0]);
+        sn[0] += v[1];
+        sn[1] += v[2];
+    }
     rms = sn[1] > 0 ? std::sqrt(sn[0]/sn[1]) : 0.0;
 }
 

@@ -18,6 +18,10 @@ ap.add_argument("--n", type=int, default=5)
 ap.add_argument("--solver", default="multilevelBSpline")
 ap.add_argument("--pimple", action="store_true")
 ap.add_argument("--np", type=int, default=1)
+ap.add_argument("--parts", type=int, nargs=3, default=None, metavar=("NX", "NY", "NZ"),
+                help="hierarchical decomposition into NX x NY x NZ boxes (default: --np slabs along x)")
+ap.add_argument("--coeff", nargs=2, action="append", default=[], metavar=("KEYWORD", "VALUE"),
+                help="an entry of the solver's coefficients (repeatable)")
 ap.add_argument("--end", type=int, default=3)
 ap.add_argument("--merge-sides", action="store_true", help="one slip patch for the four x/y faces")
 ap.add_argument("--move", type=float, default=0.06, help="x displacement of the hole at t=3")
@@ -114,12 +118,14 @@ write("system/fvSolution", "dictionary", "fvSolution",
       '"cellDisplacement.*" { solver PCG; preconditioner DIC; tolerance 1e-10; relTol 0; } }\n'
       'PIMPLE { nOuterCorrectors 1; nCorrectors 2; nNonOrthogonalCorrectors 0; correctPhi yes; pRefCell 0; pRefValue 0; }')
 write("system/decomposeParDict", "dictionary", "decomposeParDict",
-      "numberOfSubdomains %d; method hierarchical; coeffs { n (%d 1 1); order xyz; }" % (a.np, a.np))
+      "numberOfSubdomains %d; method hierarchical; coeffs { n (%d %d %d); order xyz; }"
+      % ((a.np,) + tuple(a.parts or (a.np, 1, 1))))
 
 layers = ("rigidLayers { patches (%s); innerDistance %.17g; outerDistance %.17g; }"
           % ((a.layer_patches,) + tuple(a.rigid_layers)) if a.rigid_layers else "")
-coeffs = {"multilevelBSpline": "multilevelBSplineCoeffs { tolerance 1e-10; %s }" % layers,
-          "RBF": "RBFCoeffs { %s }" % layers,
+extra = " ".join("%s %s;" % (k, v) for k, v in a.coeff)
+coeffs = {"multilevelBSpline": "multilevelBSplineCoeffs { tolerance 1e-10; %s %s }" % (layers, extra),
+          "RBF": "RBFCoeffs { %s %s }" % (layers, extra),
           "displacementLaplacian": "displacementLaplacianCoeffs { diffusivity quadratic inverseDistance 1 (hole); }"}
 libs = '("libbsplineMorph.so")' if a.solver != "displacementLaplacian" else '("libfvMotionSolvers.so")'
 write("constant/dynamicMeshDict", "dictionary", "dynamicMeshDict",

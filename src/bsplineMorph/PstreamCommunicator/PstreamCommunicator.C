@@ -115,4 +115,52 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
 }
 
 
+std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeKnownBytes
+(
+    const std::vector<mba::bytes>& send,
+    const std::vector<std::size_t>& recvSizes
+) const
+{
+    const label nProcs = size();
+    const label me = rank();
+    std::vector<mba::bytes> got(nProcs);
+    got[me] = send[me];
+    if (!Pstream::parRun())
+    {
+        return got;
+    }
+
+    const label start = UPstream::nRequests();
+    for (label proci = 0; proci < nProcs; ++proci)
+    {
+        if (proci != me && recvSizes[proci] > 0)
+        {
+            got[proci].resize(recvSizes[proci]);
+            UIPstream::read
+            (
+                Pstream::commsTypes::nonBlocking,
+                proci,
+                got[proci].data(),
+                std::streamsize(recvSizes[proci])
+            );
+        }
+    }
+    for (label proci = 0; proci < nProcs; ++proci)
+    {
+        if (proci != me && !send[proci].empty())
+        {
+            UOPstream::write
+            (
+                Pstream::commsTypes::nonBlocking,
+                proci,
+                send[proci].data(),
+                std::streamsize(send[proci].size())
+            );
+        }
+    }
+    UPstream::waitRequests(start);
+    return got;
+}
+
+
 // ************************************************************************* //

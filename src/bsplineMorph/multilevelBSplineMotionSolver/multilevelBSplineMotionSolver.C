@@ -51,6 +51,13 @@ namespace Foam
             { initialApproximation::none, "none" },
         });
 
+        const Enum<mba::params::exchangeMode> exchangeNames
+        ({
+            { mba::params::exchangeMode::automatic, "automatic" },
+            { mba::params::exchangeMode::direct, "direct" },
+            { mba::params::exchangeMode::chunked, "chunked" },
+        });
+
         //- The control points of bc (points0 in the solution directions,
         //  packed)
         std::vector<double> controlCoordinates
@@ -139,12 +146,13 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     const mba::fitReport& r = plan_.report();
     const word& type = multilevelBSplineMotionSolver::typeName;
     double nodes = 0, bytes = 0, messages = 0;
-    label separated = 0;
+    label separated = 0, chunked = 0;
     for (const mba::levelStats& s : plan_.stats())
     {
         if (s.level < r.levels)
         {
             separated += s.separated;
+            chunked += s.chunked;
             nodes += s.nodes;
             bytes += s.bytesReceivedPerApply;
             messages += s.messagesReceived;
@@ -153,6 +161,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
                 Pout<< type << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
                     << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
                     << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
+                    << (s.chunked ? " chunked" : "")
                     << " received " << s.bytesReceivedPerApply
                     << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
                     << s.planSeconds << " s)" << endl;
@@ -166,7 +175,12 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     messages = returnReduce(messages, sumOp<scalar>());
     const scalar planMB = returnReduce(scalar(plan_.bytes()), sumOp<scalar>())/1048576;
     OStringStream os;
-    os  << r.levels << " levels (" << separated << " separated), max residual " << r.maxResidual
+    os  << r.levels << " levels (" << separated << " separated";
+    if (Pstream::parRun())
+    {
+        os  << ", " << chunked << " chunked";
+    }
+    os  << "), max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
@@ -176,6 +190,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     report.summary = os.str();
     report.add("levels", r.levels);
     report.add("separatedLevels", separated);
+    report.add("chunkedLevels", chunked);
     report.add("maxResidual", r.maxResidual);
     report.add("threshold", r.threshold);
     report.add("converged", r.converged);
@@ -208,10 +223,14 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
             "initialApproximation", dict, initialApproximation::affine
         ) == initialApproximation::affine;
     params_.bucketTiles = coeffsInput::getInRange<label>(dict, "bucketTiles", 32, 1);
+    params_.exchange = exchangeNames.lookupOrDefault
+    (
+        "exchange", dict, mba::params::exchangeMode::automatic
+    );
     warnUnknownKeywords
     ({
         "tolerance", "relativeTolerance", "maxLevels", "initialGrid",
-        "initialApproximation", "bucketTiles"
+        "initialApproximation", "bucketTiles", "exchange"
     });
 }
 
