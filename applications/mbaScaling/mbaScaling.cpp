@@ -1,8 +1,8 @@
 // mbaScaling: per-rank communication and work of the distributed multilevel
 // B-spline core on the twisted cube, on simulated ranks (OpenFOAM-free).
 //
-//   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical]
-//              [--levels]
+//   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
+//              [--levels] [--steps S]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -11,16 +11,18 @@
 // components each. The sides and the interior are evaluated. The cells are
 // split as decomposePar splits this mesh: `simple` in P slabs along x (n (P 1
 // 1)), `hierarchical` in a x b x c boxes (a >= b >= c, as near equal as P
-// allows). A point on a processor boundary is held by every rank whose cells
+// allows), `columns` in a x b x 1 (hierarchical, n (a b 1): every rank holds
+// its share of the top and the bottom). A point on a processor boundary is held by every rank whose cells
 // it touches (each evaluates it); a control point belongs to the lowest of
 // them, as the motion solver counts it.
 //
-// Per rank count: the plan and a first fit, then one step measured (a fit
-// through the plan with new values, and the evaluation). Per rank: its control
+// Per rank count: the plan and a first fit, then a step measured (a fit
+// through the plan with new values, and the evaluation; the mean of --steps). Per rank: its control
 // and evaluation points, its neighbours (ranks it shares points with), what it
 // receives point-to-point in the step (bytes, messages), what the step's
 // collectives cost it, and the CPU time of its fit and evaluation (thread CPU
-// time: each simulated rank's own work, whatever the cores). Prints a table per
+// time: each simulated rank's own work, whatever the cores; less the time in
+// the simulated communicator, which a network replaces). Prints a table per
 // rank count and one RESULT line each (key=value), which benchmarks/scaling
 // reads; --levels adds the per-level exchange of the rank that receives most.
 
@@ -31,6 +33,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <iostream>
 #include <mutex>
@@ -48,12 +51,14 @@ struct options
     std::vector<int> ranks{1, 2, 4, 8, 16, 32, 64};
     std::string decomposition = "simple";
     bool levels = false;
+    int steps = 1;
 };
 
 [[noreturn]] void usage(const std::string& msg)
 {
     std::cerr << "mbaScaling: " << msg << "\n"
-        "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical] [--levels]\n";
+        "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
+        "                  [--levels] [--steps S]\n";
     std::exit(2);
 }
 
@@ -78,24 +83,27 @@ options parse(int argc, char** argv)
             }
             else if (a == "--decomposition") o.decomposition = val();
             else if (a == "--levels") o.levels = true;
+            else if (a == "--steps") o.steps = std::stoi(val());
             else usage("unknown option " + a);
         }
         catch (const std::logic_error&) { usage("bad value for " + a); }
     }
-    if (o.decomposition != "simple" && o.decomposition != "hierarchical")
-        usage("--decomposition must be simple or hierarchical");
+    if (o.decomposition != "simple" && o.decomposition != "hierarchical" && o.decomposition != "columns")
+        usage("--decomposition must be simple, hierarchical or columns");
     if (o.n < 2) usage("--n must be at least 2");
+    if (o.steps < 1) usage("--steps must be at least 1");
     for (int p : o.ranks) if (p < 1 || p > o.n) usage("every rank count must be in [1, n]");
     if (o.ranks.empty()) usage("--ranks needs at least one rank count");
     return o;
 }
 
-/// Parts per direction: (P 1 1), or the most even a >= b >= c with a b c = P
+/// Parts per direction: (P 1 1), the most even a >= b >= c with a b c = P,
+/// or the most even a >= b with a b = P (columns: c = 1)
 std::array<int, 3> parts(int P, const std::string& how)
 {
     if (how == "simple") return {P, 1, 1};
     std::array<int, 3> best{P, 1, 1};
-    for (int c = 1; c*c*c <= P; ++c)
+    for (int c = 1; how == "columns" ? c == 1 : c*c*c <= P; ++c)
     {
         if (P % c) continue;
         for (int b = c; b*b <= P/c; ++b)
@@ -114,6 +122,58 @@ double threadSeconds()
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return double(t.tv_sec) + 1e-9*double(t.tv_nsec);
 }
+
+/// A simulated rank's communicator that counts the thread CPU time spent in
+/// it: what the simulation costs (copies, barriers of threads that share
+/// two cores), which a network replaces; the rank's work is the rest
+class timedCommunicator : public communicator
+{
+    const communicator& inner_;
+    mutable double seconds_ = 0;
+    mutable long gathers_ = 0, exchanges_ = 0;
+
+    template <class F>
+    auto timed(F f) const -> decltype(f())
+    {
+        const double t = threadSeconds();
+        auto r = f();
+        seconds_ += threadSeconds() - t;
+        return r;
+    }
+
+protected:
+    std::vector<bytes> allGatherBytes(const bytes& mine) const override
+    {
+        ++gathers_;
+        return timed([&] { return inner_.allGather(mine); });
+    }
+    std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const override
+    {
+        ++exchanges_;
+        return timed([&] { return inner_.exchange(send); });
+    }
+    void exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const override
+    {
+        ++exchanges_;
+        // through the simulated ranks' exchange (the in-place one is protected);
+        // the copies are the simulation's too (a network reads and writes in place)
+        timed([&] {
+            std::vector<bytes> b(size());
+            for (int r = 0; r < size(); ++r) if (send[r].size) b[r].assign(send[r].data, send[r].data + send[r].size);
+            const std::vector<bytes> got = inner_.exchange(b);
+            for (int r = 0; r < size(); ++r) if (recv[r].size) std::memcpy(recv[r].data, got[r].data(), recv[r].size);
+            return 0;
+        });
+    }
+
+public:
+    explicit timedCommunicator(const communicator& inner) : inner_(inner) {}
+    int rank() const override { return inner_.rank(); }
+    int size() const override { return inner_.size(); }
+    double seconds() const { return seconds_; }
+    long gathers() const { return gathers_; }
+    long exchanges() const { return exchanges_; }
+};
 
 /// The twisted cube's top and bottom at t = 1: displacement of the point x
 point<3> displacement(const point<3>& x)
@@ -134,7 +194,7 @@ point<3> displacement(const point<3>& x)
 struct rankFigures
 {
     double control = 0, evaluation = 0, neighbours = 0;
-    double bytes = 0, messages = 0, collectiveBytes = 0, collectives = 0;
+    double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
 };
 
@@ -157,7 +217,8 @@ rankResult runRanks(const options& o, int P)
     rankResult res;
     res.ranks.resize(P);
     std::mutex mtx;
-    runSimulated(P, [&](const communicator& comm) {
+    runSimulated(P, [&](const communicator& simulated) {
+        const timedCommunicator comm(simulated);
         const int r = comm.rank();
         const std::array<int, 3> pr{r % m[0], (r/m[0]) % m[1], r/(m[0]*m[1])};
         std::array<long, 3> lo, hi;
@@ -202,18 +263,27 @@ rankResult runRanks(const options& o, int P)
         mba.evaluate(out);
         f.planCpu = threadSeconds() - t;
 
-        // the step: a fit through the plan, the evaluation
+        // the step: a fit through the plan, the evaluation (the mean of --steps)
         const trafficStats before = comm.traffic();
-        t = threadSeconds();
-        const fitReport& rep = mba.fit(v2);
-        f.fitCpu = threadSeconds() - t;
-        t = threadSeconds();
-        mba.evaluate(out);
-        f.evalCpu = threadSeconds() - t;
+        const long gathers0 = comm.gathers(), exchanges0 = comm.exchanges();
+        for (int step = 0; step < o.steps; ++step)
+        {
+            double c = comm.seconds();
+            t = threadSeconds();
+            mba.fit(step % 2 ? v1 : v2);
+            f.fitCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
+            c = comm.seconds();
+            t = threadSeconds();
+            mba.evaluate(out);
+            f.evalCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
+        }
+        const fitReport& rep = mba.report();
         const trafficStats after = comm.traffic();
-        f.bytes = double(after.bytesReceived - before.bytesReceived);
-        f.messages = double(after.messagesReceived - before.messagesReceived);
-        f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes);
+        f.bytes = double(after.bytesReceived - before.bytesReceived)/o.steps;
+        f.messages = double(after.messagesReceived - before.messagesReceived)/o.steps;
+        f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes)/o.steps;
+        f.gathers = double(comm.gathers() - gathers0)/o.steps;
+        f.exchanges = double(comm.exchanges() - exchanges0)/o.steps;
 
         std::lock_guard<std::mutex> lock(mtx);
         res.ranks[r] = f;
@@ -266,6 +336,8 @@ int main(int argc, char** argv)
             const summary bytes = over(v, [](const rankFigures& f) { return f.bytes; });
             const summary msgs = over(v, [](const rankFigures& f) { return f.messages; });
             const summary coll = over(v, [](const rankFigures& f) { return f.collectiveBytes; });
+            const summary gathers = over(v, [](const rankFigures& f) { return f.gathers; });
+            const summary exchanges = over(v, [](const rankFigures& f) { return f.exchanges; });
             const summary fit = over(v, [](const rankFigures& f) { return f.fitCpu; });
             const summary ev = over(v, [](const rankFigures& f) { return f.evalCpu; });
             const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
@@ -282,12 +354,13 @@ int main(int argc, char** argv)
             std::printf("RESULT n=%ld decomposition=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
                         "ctrl_mean=%.1f eval_max=%.0f eval_mean=%.1f neighbours_max=%.0f recv_bytes_max=%.0f "
                         "recv_bytes_mean=%.1f share_bytes=%.1f messages_max=%.0f messages_mean=%.2f "
-                        "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f fit_cpu_max=%.6f "
+                        "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
+                        "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
                         "plan_cpu_max=%.4f max_residual=%.3e\n",
                         n, o.decomposition.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
-                        coll.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
+                        coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
                         res.maxResidual);
             if (o.levels)
             {

@@ -36,15 +36,20 @@ std::int64_t communicator::sum(std::int64_t x) const
     return s;
 }
 
-std::vector<bytes> communicator::exchangeKnownBytes(const std::vector<bytes>& send,
-                                                  const std::vector<std::size_t>& recvSizes) const
+void communicator::exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const
 {
-    std::vector<bytes> got = exchangeBytes(send);
-    for (std::size_t r = 0; r < got.size(); ++r)
-        if (got[r].size() != recvSizes[r])
-            throw std::logic_error("mba: rank " + std::to_string(rank()) + " expected " + std::to_string(recvSizes[r])
+    std::vector<bytes> b(size());
+    for (int r = 0; r < size(); ++r)
+        if (r != rank() && send[r].size) b[r].assign(send[r].data, send[r].data + send[r].size);
+    const std::vector<bytes> got = exchangeBytes(b);
+    for (int r = 0; r < size(); ++r)
+    {
+        if (r == rank()) continue;
+        if (got[r].size() != recv[r].size)
+            throw std::logic_error("mba: rank " + std::to_string(rank()) + " expected " + std::to_string(recv[r].size)
                                    + " bytes from rank " + std::to_string(r) + ", got " + std::to_string(got[r].size()));
-    return got;
+        if (recv[r].size) std::memcpy(recv[r].data, got[r].data(), recv[r].size);
+    }
 }
 
 void communicator::check(bool ok, const std::string& msg) const

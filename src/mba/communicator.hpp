@@ -33,6 +33,19 @@ struct trafficStats
     std::uint64_t collectiveBytes = 0;   ///< bytes this rank contributed to all-gathers
 };
 
+/// Bytes to send, or to receive into
+struct constByteRange
+{
+    const char* data;
+    std::size_t size;
+};
+
+struct byteRange
+{
+    char* data;
+    std::size_t size;
+};
+
 class communicator
 {
     mutable trafficStats traffic_;
@@ -42,11 +55,11 @@ protected:
     virtual std::vector<bytes> allGatherBytes(const bytes& mine) const = 0;
     /// send[r] goes to rank r (empty: no message); returns what rank r sent here
     virtual std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const = 0;
-    /// The same when this rank knows what each rank sends it (recvSizes[r]
-    /// bytes; 0: no message), as in every apply of a plan: no sizes need to
-    /// travel. By default exchangeBytes, with the sizes checked.
-    virtual std::vector<bytes> exchangeKnownBytes(const std::vector<bytes>& send,
-                                                  const std::vector<std::size_t>& recvSizes) const;
+    /// send[r] goes to rank r; what rank r sends comes into recv[r], whose
+    /// size this rank knows (as in every apply of a plan: no sizes need to
+    /// travel, nothing is allocated); size 0: no message; this rank's own
+    /// entries are ignored. By default through exchangeBytes, sizes checked.
+    virtual void exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const;
 
 public:
     virtual ~communicator() = default;
@@ -71,16 +84,55 @@ public:
     template <class T>
     std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send) const
     {
-        return exchangeAs<T>(send, nullptr);
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        std::vector<bytes> b(size());
+        for (int r = 0; r < size(); ++r)
+        {
+            if (r >= int(send.size()) || send[r].empty()) continue;
+            b[r].resize(send[r].size()*sizeof(T));
+            std::memcpy(b[r].data(), send[r].data(), b[r].size());
+            if (r != rank()) { ++traffic_.messagesSent; traffic_.bytesSent += b[r].size(); }
+        }
+        const std::vector<bytes> got = exchangeBytes(b);
+        std::vector<std::vector<T>> out(got.size());
+        for (std::size_t r = 0; r < got.size(); ++r)
+        {
+            if (!got[r].empty() && int(r) != rank())
+            {
+                ++traffic_.messagesReceived;
+                traffic_.bytesReceived += got[r].size();
+            }
+            out[r] = fromBytes<T>(got[r]);
+        }
+        return out;
     }
 
-    /// exchange when this rank knows how many values each rank sends it
-    /// (recvCounts[r]; the plan of an apply does): no sizes travel
+    /// exchange into arrays this rank has sized to what each rank sends it
+    /// (recv[r].size() values; the plan of an apply knows them): no sizes
+    /// travel, nothing is allocated. This rank's own entries are ignored.
     template <class T>
-    std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send,
-                                         const std::vector<std::size_t>& recvCounts) const
+    void exchange(const std::vector<std::vector<T>>& send, std::vector<std::vector<T>>& recv) const
     {
-        return exchangeAs<T>(send, &recvCounts);
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        std::vector<constByteRange> s(size(), constByteRange{nullptr, 0});
+        std::vector<byteRange> r(size(), byteRange{nullptr, 0});
+        for (int q = 0; q < size(); ++q)
+        {
+            if (q == rank()) continue;
+            if (q < int(send.size()) && !send[q].empty())
+            {
+                s[q] = constByteRange{reinterpret_cast<const char*>(send[q].data()), send[q].size()*sizeof(T)};
+                ++traffic_.messagesSent;
+                traffic_.bytesSent += s[q].size;
+            }
+            if (q < int(recv.size()) && !recv[q].empty())
+            {
+                r[q] = byteRange{reinterpret_cast<char*>(recv[q].data()), recv[q].size()*sizeof(T)};
+                ++traffic_.messagesReceived;
+                traffic_.bytesReceived += r[q].size;
+            }
+        }
+        exchangeInPlace(s, r);
     }
 
     /// Element-wise sum over ranks, added in rank order: identical on every rank
@@ -95,41 +147,6 @@ public:
     void check(bool ok, const std::string& msg) const;
 
 private:
-    template <class T>
-    std::vector<std::vector<T>> exchangeAs(const std::vector<std::vector<T>>& send,
-                                           const std::vector<std::size_t>* recvCounts) const
-    {
-        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
-        std::vector<bytes> b(size());
-        for (int r = 0; r < size(); ++r)
-        {
-            if (r >= int(send.size()) || send[r].empty()) continue;
-            b[r].resize(send[r].size()*sizeof(T));
-            std::memcpy(b[r].data(), send[r].data(), b[r].size());
-            if (r != rank()) { ++traffic_.messagesSent; traffic_.bytesSent += b[r].size(); }
-        }
-        std::vector<bytes> got;
-        if (recvCounts)
-        {
-            std::vector<std::size_t> sizes(size(), 0);
-            for (int r = 0; r < size() && r < int(recvCounts->size()); ++r) sizes[r] = (*recvCounts)[r]*sizeof(T);
-            sizes[rank()] = b[rank()].size();
-            got = exchangeKnownBytes(b, sizes);
-        }
-        else got = exchangeBytes(b);
-        std::vector<std::vector<T>> out(got.size());
-        for (std::size_t r = 0; r < got.size(); ++r)
-        {
-            if (!got[r].empty() && int(r) != rank())
-            {
-                ++traffic_.messagesReceived;
-                traffic_.bytesReceived += got[r].size();
-            }
-            out[r] = fromBytes<T>(got[r]);
-        }
-        return out;
-    }
-
     template <class T>
     static std::vector<T> fromBytes(const bytes& b)
     {

@@ -154,18 +154,23 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
         else exchangePartialSums(L, residuals);
     }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
-    // too); separated levels hold phi already
-    if (!L.separated) divideByOmega(L);
+    // too); separated levels hold phi already, chunked ones received it
+    if (!L.separated && !L.chunked) divideByOmega(L);
     subtractLevel(L, residuals);
 }
 
 /// Zero delta; of a separated level only the tiles that other ranks' values
-/// are added to
+/// are added to, of a chunked one only the own tiles
 template <int D>
 void levelApplier<D>::clearLattice(levelPlan<D>& L) const
 {
     const int blk = levelPlan<D>::npt*ctrl_.nComponents;
-    if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    if (L.chunked)
+    {
+        // the other tiles' nodes are all received (round 2) or never written
+        for (const std::int64_t id : L.chunks.ownTiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);
+    }
+    else if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
     else
         for (const auto& tiles : L.tilesFrom)
             for (const std::int64_t id : tiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);
@@ -241,67 +246,71 @@ template <int D>
 void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals)
 {
     const int P = comm_.size(), nc = ctrl_.nComponents, blk = levelPlan<D>::npt*nc;
-    std::vector<std::vector<double>> send(P);
+    send_.resize(P);
+    recv_.resize(P);
+    ghostSums_.resize(P);
     for (int r = 0; r < P; ++r)
     {
+        send_[r].clear();
+        recv_[r].resize(L.receiveCounts[r]);
         if (!L.ghostsTo[r].empty())
         {
             for (const std::uint32_t i : L.ghostsTo[r])
-                send[r].insert(send[r].end(), &residuals[i*nc], &residuals[i*nc] + nc);
+                send_[r].insert(send_[r].end(), &residuals[i*nc], &residuals[i*nc] + nc);
             continue;
         }
-        send[r].reserve(L.tilesTo[r].size()*blk);
-        for (auto id : L.tilesTo[r]) send[r].insert(send[r].end(), &L.phi[id*blk], &L.phi[(id + 1)*blk]);
+        for (auto id : L.tilesTo[r]) send_[r].insert(send_[r].end(), &L.phi[id*blk], &L.phi[(id + 1)*blk]);
     }
-    std::vector<std::vector<double>> got = comm_.exchange(send, L.receiveCounts);
+    comm_.exchange(send_, recv_);
+    std::vector<const double*> got(P, nullptr);
     for (int r = 0; r < P; ++r)
-        if (!L.ghostTiles[r].empty()) got[r] = ghostPartialSums(L, r, got[r]);
+    {
+        if (L.ghostTiles[r].empty()) got[r] = recv_[r].data();
+        else
+        {
+            ghostPartialSums(L, r, recv_[r], ghostSums_[r]);
+            got[r] = ghostSums_[r].data();
+        }
+    }
     addInRankOrder(L, got);
 }
 
-/// Rank r's partial delta on the tiles received from it, formed from its
-/// ghosts' residuals (got: nc a ghost) as r forms it: a run of points with
-/// the same stencil nodes is sent whole or not at all (its points touch the
-/// same tiles), and scattered as a run here as there
+/// Rank r's partial delta on the tiles received from it (dl), formed from
+/// its ghosts' residuals (got: nc a ghost) as r forms it: a run of points
+/// with the same stencil nodes is sent whole or not at all (its points
+/// touch the same tiles), and scattered as a run here as there
 template <int D>
-std::vector<double> levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got) const
+void levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got,
+                                       std::vector<double>& dl)
 {
     const int nc = ctrl_.nComponents, blk = levelPlan<D>::npt*nc;
     const std::size_t stride = D + nc, ng = L.ghostTiles[r].size();
-    std::vector<double> dl(L.tilesFrom[r].size()*blk, 0.0);
-    std::vector<stencil<D>> st(ng);
-    std::vector<double> rr(ng*nc, 0.0);
-    std::vector<std::uint8_t> on(ng*nc);
+    const std::vector<stencil<D>>& st = L.ghostStencils[r];
+    dl.assign(L.tilesFrom[r].size()*blk, 0.0);
+    std::vector<double>& rr = ghostResiduals_;
+    rr.assign(ng*nc, 0.0);
     for (std::size_t g = 0; g < ng; ++g)
     {
         const double* x = &L.ghostsFrom[r][g*stride];
-        st[g] = levelStencil<D>(dom_.local0(x), L.scale);
-        const double isw = 1/st[g].sumSquares();
-        for (int c = 0; c < nc; ++c)
-        {
-            on[g*nc + c] = x[D + c] != 0;
-            rr[g*nc + c] = on[g*nc + c] ? got[g*nc + c]*isw : 0.0;
-        }
+        for (int c = 0; c < nc; ++c) rr[g*nc + c] = x[D + c] != 0 ? got[g*nc + c]*L.ghostScales[r][g] : 0.0;
     }
     if (L.separated)
     {
         for (std::size_t g = 0; g < ng; ++g)
         {
-            bool o[3];
-            for (int c = 0; c < nc; ++c) o[c] = on[g*nc + c];
+            bool on[3];
+            for (int c = 0; c < nc; ++c) on[c] = L.ghostsFrom[r][g*stride + D + c] != 0;
             scatterSeparated<D>(dl.data(), nc, L.ghostTiles[r][g], st[g], &rr[g*nc],
-                                ctrl_.omegaPerNode == 1 ? nullptr : o);
+                                ctrl_.omegaPerNode == 1 ? nullptr : on);
         }
-        return dl;
+        return;
     }
-    for (auto& s : st) s = s.cubedWeights();
     for (std::size_t g = 0, e; g < ng; g = e)
     {
         for (e = g + 1; e < ng && st[e].base == st[g].base; ++e) {}
         if (e - g >= minRun) scatterRun<D>(dl.data(), nc, L.ghostTiles[r][g], &st[g], &rr[g*nc], e - g);
         else for (std::size_t j = g; j < e; ++j) scatter<D>(dl.data(), nc, L.ghostTiles[r][j], st[j], &rr[j*nc]);
     }
-    return dl;
 }
 
 /// Sum over ranks, in rank order (every rank holding a node adds the same
@@ -310,7 +319,7 @@ std::vector<double> levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int
 /// set aside and added at this rank's turn. got: per rank, its partial sums
 /// on the tiles received from it
 template <int D>
-void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<std::vector<double>>& got)
+void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<const double*>& got)
 {
     const int blk = levelPlan<D>::npt*ctrl_.nComponents;
     std::vector<double>& own = setAside_;
@@ -336,20 +345,26 @@ void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<std::vec
 
 /// The chunked exchange (levelPlan::chunks): own partial sums to the
 /// chunks' owners; each owner sums its chunks in rank order (as
-/// addInRankOrder: the same values) and sends them to the tiles' readers
+/// addInRankOrder: the same values), divides them by omega (as
+/// divideByOmega) and sends them to the tiles' readers
 template <int D>
 void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
 {
     const int P = comm_.size(), me = comm_.rank(), nc = ctrl_.nComponents, npt = levelPlan<D>::npt;
     const chunkExchange& X = L.chunks;
     auto at = [&](const nodeRun& r) { return &L.phi[(r.tile*npt + r.node0)*nc]; };
-    auto pack = [&](const std::vector<std::vector<nodeRun>>& runs) {
-        std::vector<std::vector<double>> send(P);
+    auto exchange = [&](const std::vector<std::vector<nodeRun>>& runs, const std::vector<std::size_t>& counts) {
+        send_.resize(P);
+        recv_.resize(P);
         for (int r = 0; r < P; ++r)
-            for (const nodeRun& run : runs[r]) send[r].insert(send[r].end(), at(run), at(run) + run.nodes*nc);
-        return send;
+        {
+            send_[r].clear();
+            for (const nodeRun& run : runs[r]) send_[r].insert(send_[r].end(), at(run), at(run) + run.nodes*nc);
+            recv_[r].resize(counts[r]);
+        }
+        comm_.exchange(send_, recv_);
     };
-    const std::vector<std::vector<double>> partials = comm_.exchange(pack(X.partialTo), X.partialCounts);
+    exchange(X.partialTo, X.partialCounts);
     std::vector<double>& sum = chunkSum_;
     for (std::size_t k = 0; k < X.owned.size(); ++k)
     {
@@ -359,15 +374,16 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
         for (std::int64_t t = X.termsBegin[k]; t < X.termsBegin[k + 1]; ++t)
         {
             const int r = X.terms[t].first;
-            const double* v = r == me ? ph : &partials[r][X.terms[t].second];
+            const double* v = r == me ? ph : &recv_[r][X.terms[t].second];
             for (std::size_t j = 0; j < n; ++j) sum[j] += v[j];
         }
         std::copy(sum.begin(), sum.end(), ph);
+        divideByOmega(L, X.owned[k].tile*npt + X.owned[k].node0, X.owned[k].nodes);
     }
-    const std::vector<std::vector<double>> full = comm_.exchange(pack(X.fullTo), X.fullCounts);
+    exchange(X.fullTo, X.fullCounts);
     for (int r = 0; r < P; ++r)
     {
-        const double* v = full[r].data();
+        const double* v = recv_[r].data();
         for (const nodeRun& run : X.fullFrom[r])
         {
             std::copy(v, v + run.nodes*nc, at(run));
@@ -376,15 +392,20 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
     }
 }
 
-/// phi = delta/omega: one 1/omega per node, or per value
+/// phi = delta/omega: one 1/omega per node, or per value; of nodes
+/// [first, first + n) (default: all)
 template <int D>
-void levelApplier<D>::divideByOmega(levelPlan<D>& L) const
+void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::int64_t n) const
 {
-    switch (ctrl_.omegaPerNode == 1 ? ctrl_.nComponents : 1)
+    const int nc = ctrl_.nComponents, per = ctrl_.omegaPerNode;
+    if (n < 0) n = std::int64_t(L.invOmega.size())/per;
+    double* v = &L.phi[first*nc];
+    const double* s = &L.invOmega[first*per];
+    switch (per == 1 ? nc : 1)
     {
-        case 1: scaleNodes<1>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
-        case 2: scaleNodes<2>(L.phi.data(), L.invOmega.data(), L.invOmega.size()); break;
-        default: scaleNodes<3>(L.phi.data(), L.invOmega.data(), L.invOmega.size());
+        case 1: scaleNodes<1>(v, s, std::size_t(n*per)); break;
+        case 2: scaleNodes<2>(v, s, std::size_t(n)); break;
+        default: scaleNodes<3>(v, s, std::size_t(n));
     }
 }
 
@@ -426,7 +447,12 @@ void levelApplier<D>::subtractLevel(const levelPlan<D>& L, std::vector<double>& 
 template <int D>
 std::int64_t levelApplier<D>::bytes() const
 {
-    return std::int64_t((scaledResiduals_.capacity() + setAside_.capacity())*sizeof(double)
+    std::int64_t buffers = 0;
+    for (const auto& v : send_) buffers += std::int64_t(v.capacity());
+    for (const auto& v : recv_) buffers += std::int64_t(v.capacity());
+    for (const auto& v : ghostSums_) buffers += std::int64_t(v.capacity());
+    buffers += std::int64_t(ghostResiduals_.capacity());
+    return std::int64_t((scaledResiduals_.capacity() + setAside_.capacity() + chunkSum_.capacity() + buffers)*sizeof(double)
         + (stencils_.capacity() + cubedStencils_.capacity())*sizeof(stencil<D>));
 }
 

@@ -26,16 +26,19 @@ class levelApplier
     std::vector<double> levelValues_;       ///< the current level's values at the control points, in order
     std::vector<double> setAside_;          ///< own partial sums of the tiles shared with lower ranks
     std::vector<double> chunkSum_;          ///< one chunk's sum (chunked exchange)
+    std::vector<std::vector<double>> send_, recv_; ///< per rank: what goes there, what comes from there
+    std::vector<std::vector<double>> ghostSums_;   ///< per rank: its partial sums formed from its ghosts
+    std::vector<double> ghostResiduals_;           ///< a rank's ghosts' r/sum(w^2)
 
     void clearLattice(levelPlan<D>& L) const;
     void computeStencils(const levelPlan<D>& L);
     void scaleResiduals(std::vector<double>& rr, const std::vector<double>& residuals) const;
     void scatterOwn(levelPlan<D>& L, const std::vector<double>& rr) const;
     void exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals);
-    std::vector<double> ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got) const;
-    void addInRankOrder(levelPlan<D>& L, const std::vector<std::vector<double>>& got);
+    void ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got, std::vector<double>& dl);
+    void addInRankOrder(levelPlan<D>& L, const std::vector<const double*>& got);
     void exchangeChunks(levelPlan<D>& L);
-    void divideByOmega(levelPlan<D>& L) const;
+    void divideByOmega(levelPlan<D>& L, std::int64_t first = 0, std::int64_t n = -1) const;
     void subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals);
 
 public:

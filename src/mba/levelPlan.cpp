@@ -406,6 +406,8 @@ template <int D>
 void levelPlanner<D>::findGhostTiles()
 {
     L_.ghostTiles.assign(nRanks_, {});
+    L_.ghostStencils.assign(nRanks_, {});
+    L_.ghostScales.assign(nRanks_, {});
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
     {
         if (L_.ghostsFrom[r].empty()) continue;
@@ -416,8 +418,11 @@ void levelPlanner<D>::findGhostTiles()
         for (std::size_t g = 0; g < ng; ++g)
         {
             stencilTiles<D>& tid = L_.ghostTiles[r][g];
-            findTiles(L_.view, levelStencil<D>(dom_.local0(&L_.ghostsFrom[r][g*stride]), L_.scale), tid);
+            const stencil<D> st = levelStencil<D>(dom_.local0(&L_.ghostsFrom[r][g*stride]), L_.scale);
+            findTiles(L_.view, st, tid);
             for (std::int32_t& id : tid) if (id >= 0) id = at[id];
+            L_.ghostStencils[r].push_back(L_.separated ? st : st.cubedWeights());
+            L_.ghostScales[r].push_back(1/st.sumSquares());
         }
     }
     for (const auto& g : L_.ghostsTo) L_.hasGhosts = L_.hasGhosts || !g.empty();
@@ -499,7 +504,8 @@ chunkExchange levelPlanner<D>::planChunks() const
             for (std::int64_t q = rBegin[id]; q < rBegin[id + 1]; ++q) X.fullTo[readers[q]].push_back(run);
         }
     }
-    X.partialCounts.assign(offset.begin(), offset.end());
+    X.ownTiles = ownToView_;
+        X.partialCounts.assign(offset.begin(), offset.end());
     for (int r = 0; r < nRanks_; ++r) X.fullCounts.push_back(std::size_t(runValues(X.fullFrom[r], nc_)));
     return X;
 }
@@ -530,6 +536,8 @@ void levelPlanner<D>::chooseExchange()
     L_.ghostsTo.assign(nRanks_, {});
     L_.ghostsFrom.assign(nRanks_, {});
     L_.ghostTiles.assign(nRanks_, {});
+    L_.ghostStencils.assign(nRanks_, {});
+    L_.ghostScales.assign(nRanks_, {});
     L_.hasGhosts = false;
 }
 
@@ -595,8 +603,8 @@ void levelPlanner<D>::fillStats()
             : std::int64_t(L.ghostTiles[r].size())*nc_;
         s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
         s.bytesReceivedPerApply += vr*std::int64_t(sizeof(double));
-        s.bytes += std::int64_t(L.ghostsFrom[r].capacity()*sizeof(double)
-            + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>));
+        s.bytes += std::int64_t((L.ghostsFrom[r].capacity() + L.ghostScales[r].capacity())*sizeof(double)
+            + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>) + L.ghostStencils[r].capacity()*sizeof(stencil<D>));
     }
 }
 

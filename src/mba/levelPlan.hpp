@@ -49,9 +49,10 @@ struct nodeRun
 /// contributors C (sorted ranks) is split into min(|C|, npt) chunks of
 /// nodes; chunk j belongs to C[(j + key) mod |C|]. Round 1: every
 /// contributor sends its partial sums on the chunks of its tiles that
-/// others own to their owners; each owner sums its chunks in rank order.
-/// Round 2: each owner sends its summed chunks to every other rank that
-/// reads the tile. Both sides list a message's runs in tile-key order,
+/// others own to their owners; each owner sums its chunks in rank order
+/// and divides them by omega. Round 2: each owner sends its chunks' phi to
+/// every other rank that reads the tile, which stores it: a rank clears and
+/// divides only what it owns. Both sides list a message's runs in tile-key order,
 /// chunks in order.
 struct chunkExchange
 {
@@ -64,6 +65,7 @@ struct chunkExchange
     std::vector<std::pair<std::int32_t, std::int64_t>> terms;
     std::vector<std::vector<nodeRun>> fullTo;    ///< per rank: summed chunks sent to it (round 2)
     std::vector<std::vector<nodeRun>> fullFrom;  ///< per rank: summed chunks it sends here
+    std::vector<std::int64_t> ownTiles;          ///< the own tiles (view ids): all that is cleared per apply
     std::vector<std::size_t> partialCounts;      ///< per rank: values it sends here in round 1
     std::vector<std::size_t> fullCounts;         ///< per rank: values it sends here in round 2
 };
@@ -109,6 +111,9 @@ struct levelPlan
     std::vector<std::vector<std::uint32_t>> ghostsTo; ///< per rank: own points whose residuals go there (ghost mode)
     std::vector<std::vector<double>> ghostsFrom;      ///< per rank: its ghosts, D coordinates + nc mask flags each
     std::vector<std::vector<stencilTiles<D>>> ghostTiles; ///< per rank: its ghosts' tiles, as positions in tilesFrom
+    /// per rank: its ghosts' stencils (weights cubed unless separated) and 1/sum(w^2)
+    std::vector<std::vector<stencil<D>>> ghostStencils;
+    std::vector<std::vector<double>> ghostScales;
     bool hasGhosts = false;         ///< this rank sends or receives ghosts at this level
 
     bool chunked = false;           ///< the partial sums meet in chunks (chunks), not directly

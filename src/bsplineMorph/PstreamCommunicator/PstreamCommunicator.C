@@ -115,51 +115,46 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
 }
 
 
-std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeKnownBytes
+void Foam::PstreamCommunicator::exchangeInPlace
 (
-    const std::vector<mba::bytes>& send,
-    const std::vector<std::size_t>& recvSizes
+    const std::vector<mba::constByteRange>& send,
+    const std::vector<mba::byteRange>& recv
 ) const
 {
-    const label nProcs = size();
-    const label me = rank();
-    std::vector<mba::bytes> got(nProcs);
-    got[me] = send[me];
     if (!Pstream::parRun())
     {
-        return got;
+        return;
     }
-
+    const label nProcs = size();
+    const label me = rank();
     const label start = UPstream::nRequests();
     for (label proci = 0; proci < nProcs; ++proci)
     {
-        if (proci != me && recvSizes[proci] > 0)
+        if (proci != me && recv[proci].size > 0)
         {
-            got[proci].resize(recvSizes[proci]);
             UIPstream::read
             (
                 Pstream::commsTypes::nonBlocking,
                 proci,
-                got[proci].data(),
-                std::streamsize(recvSizes[proci])
+                recv[proci].data,
+                std::streamsize(recv[proci].size)
             );
         }
     }
     for (label proci = 0; proci < nProcs; ++proci)
     {
-        if (proci != me && !send[proci].empty())
+        if (proci != me && send[proci].size > 0)
         {
             UOPstream::write
             (
                 Pstream::commsTypes::nonBlocking,
                 proci,
-                send[proci].data(),
-                std::streamsize(send[proci].size())
+                send[proci].data,
+                std::streamsize(send[proci].size)
             );
         }
     }
     UPstream::waitRequests(start);
-    return got;
 }
 
 
