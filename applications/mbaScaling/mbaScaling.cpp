@@ -62,6 +62,25 @@ struct options
     std::exit(2);
 }
 
+/// Parts per direction: (P 1 1), the most even a >= b >= c with a b c = P,
+/// or the most even a >= b with a b = P (columns: c = 1)
+std::array<int, 3> parts(int P, const std::string& how)
+{
+    if (how == "simple") return {P, 1, 1};
+    std::array<int, 3> best{P, 1, 1};
+    for (int c = 1; how == "columns" ? c == 1 : c*c*c <= P; ++c)
+    {
+        if (P % c) continue;
+        for (int b = c; b*b <= P/c; ++b)
+        {
+            if ((P/c) % b) continue;
+            const int a = P/c/b;
+            if (a - c < best[0] - best[2]) best = {a, b, c};
+        }
+    }
+    return best;
+}
+
 options parse(int argc, char** argv)
 {
     options o;
@@ -92,28 +111,14 @@ options parse(int argc, char** argv)
         usage("--decomposition must be simple, hierarchical or columns");
     if (o.n < 2) usage("--n must be at least 2");
     if (o.steps < 1) usage("--steps must be at least 1");
-    for (int p : o.ranks) if (p < 1 || p > o.n) usage("every rank count must be in [1, n]");
+    for (int p : o.ranks)
+    {
+        if (p < 1) usage("rank counts must be positive");
+        for (int m : parts(p, o.decomposition))
+            if (m > o.n) usage("rank count " + std::to_string(p) + " splits a direction into more parts than cells");
+    }
     if (o.ranks.empty()) usage("--ranks needs at least one rank count");
     return o;
-}
-
-/// Parts per direction: (P 1 1), the most even a >= b >= c with a b c = P,
-/// or the most even a >= b with a b = P (columns: c = 1)
-std::array<int, 3> parts(int P, const std::string& how)
-{
-    if (how == "simple") return {P, 1, 1};
-    std::array<int, 3> best{P, 1, 1};
-    for (int c = 1; how == "columns" ? c == 1 : c*c*c <= P; ++c)
-    {
-        if (P % c) continue;
-        for (int b = c; b*b <= P/c; ++b)
-        {
-            if ((P/c) % b) continue;
-            const int a = P/c/b;
-            if (a - c < best[0] - best[2]) best = {a, b, c};
-        }
-    }
-    return best;
 }
 
 double threadSeconds()

@@ -399,6 +399,7 @@ void Foam::interpolatingMotionSolver::solve()
 {
     const clockTime timer;
     const bool changed = updateControls();
+    const scalar conditionsSeconds = timer.elapsedTime();
 
     // The displacement is worked out in pointDisplacement's own values (the
     // conditions have been read), and the moved points beside it: every point
@@ -421,10 +422,14 @@ void Foam::interpolatingMotionSolver::solve()
     {
         report = interpolateField(displacement, changed);
     }
+    scalar boundarySeconds = timer.elapsedTime();
     moveBoundaryPoints(displacement);
+    boundarySeconds = timer.elapsedTime() - boundarySeconds;
     label nInvalid = 0;
     const scalar checkSeconds = checkCells(newPoints_, nInvalid);
+    scalar correctSeconds = timer.elapsedTime();
     correctBoundaryValues(displacement);
+    boundarySeconds += timer.elapsedTime() - correctSeconds;
 
     if (!report.summary.empty())
     {
@@ -433,6 +438,8 @@ void Foam::interpolatingMotionSolver::solve()
             << checkSeconds << " s, " << seconds << " s" << endl;
         report.add("invalidCells", nInvalid);
         report.add("check_s", checkSeconds);
+        report.add("conditions_s", conditionsSeconds);
+        report.add("boundary_s", boundarySeconds);
         report.add("solve_s", seconds);
         writeTable(report);
     }

@@ -168,12 +168,19 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
             }
         }
     }
-    nodes = returnReduce(nodes, sumOp<scalar>());
-    const scalar bytesMax = returnReduce(bytes, maxOp<scalar>());
-    bytes = returnReduce(bytes, sumOp<scalar>());
-    const scalar messagesMax = returnReduce(messages, maxOp<scalar>());
-    messages = returnReduce(messages, sumOp<scalar>());
-    const scalar planMB = returnReduce(scalar(plan_.bytes()), sumOp<scalar>())/1048576;
+    // (two reductions for the six figures: each costs a tree of messages)
+    List<scalar> sums({nodes, bytes, messages, scalar(plan_.bytes())});
+    List<scalar> maxima({bytes, messages});
+    Pstream::listCombineGather(sums, plusEqOp<scalar>());
+    Pstream::listCombineScatter(sums);
+    Pstream::listCombineGather(maxima, maxEqOp<scalar>());
+    Pstream::listCombineScatter(maxima);
+    nodes = sums[0];
+    bytes = sums[1];
+    messages = sums[2];
+    const scalar planMB = sums[3]/1048576;
+    const scalar bytesMax = maxima[0];
+    const scalar messagesMax = maxima[1];
     OStringStream os;
     os  << r.levels << " levels (" << separated << " separated";
     if (Pstream::parRun())
