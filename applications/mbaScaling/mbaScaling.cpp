@@ -2,7 +2,7 @@
 // B-spline core on the twisted cube, on simulated ranks (OpenFOAM-free).
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
-//              [--levels] [--steps S]
+//              [--levels] [--steps S] [--lower-bound]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -24,7 +24,9 @@
 // time: each simulated rank's own work, whatever the cores; less the time in
 // the simulated communicator, which a network replaces). Prints a table per
 // rank count and one RESULT line each (key=value), which benchmarks/scaling
-// reads; --levels adds the per-level exchange of the rank that receives most.
+// reads; --levels adds the per-level exchange of the rank that receives most;
+// --lower-bound the least any exchange of values per level could receive
+// (lowerBoundBytes), against the share.
 
 #include "multilevel.hpp"
 
@@ -51,6 +53,7 @@ struct options
     std::vector<int> ranks{1, 2, 4, 8, 16, 32, 64};
     std::string decomposition = "simple";
     bool levels = false;
+    bool lowerBound = false;
     int steps = 1;
 };
 
@@ -58,7 +61,7 @@ struct options
 {
     std::cerr << "mbaScaling: " << msg << "\n"
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
-        "                  [--levels] [--steps S]\n";
+        "                  [--levels] [--steps S] [--lower-bound]\n";
     std::exit(2);
 }
 
@@ -102,6 +105,7 @@ options parse(int argc, char** argv)
             }
             else if (a == "--decomposition") o.decomposition = val();
             else if (a == "--levels") o.levels = true;
+            else if (a == "--lower-bound") o.lowerBound = true;
             else if (a == "--steps") o.steps = std::stoi(val());
             else usage("unknown option " + a);
         }
@@ -195,12 +199,98 @@ point<3> displacement(const point<3>& x)
     return d;
 }
 
+/// The least a rank must receive per step (bytes) for any exchange of values
+/// per level, the lattice's or the control points' (this one's or another):
+/// per level, the nodes its query points' stencils touch that some other
+/// rank's control point touches (it cannot form their values alone), or
+/// else those other ranks' control points that touch them, whichever are
+/// fewer, 3 values of 8 bytes each. The control points are the grid's on the
+/// planes z = 0 and z = 1; owner(i, j, k) is the rank holding grid point (i,
+/// j, k) that counts it.
+template <class Owner>
+double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vector<point<3>>& query, int me,
+                       Owner owner)
+{
+    double total = 0;
+    for (int k = 0; k < levels; ++k)
+    {
+        const double s = std::ldexp(1.0, k);
+        // a grid coordinate's stencil base at this level, per direction
+        auto base = [&](int d, long i) {
+            point<3> x{0.5, 0.5, 0.5};
+            x[d] = double(i)/n;
+            return std::int64_t(dom.local0(x.data())[d]*s);
+        };
+        std::array<std::vector<std::int64_t>, 3> gb;
+        for (int d = 0; d < 3; ++d) for (long i = 0; i <= n; ++i) gb[d].push_back(base(d, i));
+        const std::int64_t planeBase[2] = {gb[2][0], gb[2][n]};
+        const std::int64_t nx = gb[0][n] + 4, ny = gb[1][n] + 4;
+        // the query points' nodes on the planes' four layers each: (plane, layer, x, y)
+        std::vector<std::uint8_t> needed(std::size_t(2*4*nx*ny), 0);
+        std::int64_t last[3] = {-1, -1, -1};
+        for (const point<3>& x : query)
+        {
+            point<3> u = dom.local0(x.data());
+            for (double& c : u) c *= s;
+            const std::int64_t b[3] = {std::int64_t(u[0]), std::int64_t(u[1]), std::int64_t(u[2])};
+            if (b[0] == last[0] && b[1] == last[1] && b[2] == last[2]) continue;
+            std::copy(b, b + 3, last);
+            for (int p = 0; p < 2; ++p)
+                for (std::int64_t c = b[2]; c <= b[2] + 3; ++c)
+                {
+                    const std::int64_t layer = c - planeBase[p];   // node layer the plane's points touch: 0..3
+                    if (layer < 0 || layer > 3) continue;
+                    for (std::int64_t a1 = b[1]; a1 <= b[1] + 3; ++a1)
+                        for (std::int64_t a0 = b[0]; a0 <= b[0] + 3; ++a0)
+                            needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)] = 1;
+                }
+        }
+        // per plane and node column (x, y): the grid points whose stencils hold it
+        std::vector<std::uint8_t> remotePoint(std::size_t(2*(n + 1)*(n + 1)), 0);
+        double nodes = 0;
+        auto range = [&](int d, std::int64_t a, long& i0, long& i1) {
+            // grid indices i with base in [a - 3, a]
+            const auto& g = gb[d];
+            i0 = long(std::lower_bound(g.begin(), g.end(), a - 3) - g.begin());
+            i1 = long(std::upper_bound(g.begin(), g.end(), a) - g.begin()) - 1;
+        };
+        for (int p = 0; p < 2; ++p)
+            for (std::int64_t a1 = 0; a1 < ny; ++a1)
+                for (std::int64_t a0 = 0; a0 < nx; ++a0)
+                {
+                    bool any = false;
+                    for (int layer = 0; layer < 4; ++layer)
+                        any = any || needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)];
+                    if (!any) continue;
+                    long i0, i1, j0, j1;
+                    range(0, a0, i0, i1);
+                    range(1, a1, j0, j1);
+                    bool remote = false;
+                    for (long j = j0; j <= j1; ++j)
+                        for (long i = i0; i <= i1; ++i)
+                            if (owner(i, j, p ? n : 0) != me)
+                            {
+                                remote = true;
+                                remotePoint[std::size_t((p*(n + 1) + j)*(n + 1) + i)] = 1;
+                            }
+                    if (!remote) continue;
+                    for (int layer = 0; layer < 4; ++layer)
+                        nodes += needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)];
+                }
+        double points = 0;
+        for (const std::uint8_t r : remotePoint) points += r;
+        total += 24*std::min(nodes, points);
+    }
+    return total;
+}
+
 /// One rank's figures of the measured step
 struct rankFigures
 {
     double control = 0, evaluation = 0, neighbours = 0;
     double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
+    double lowerBound = 0;   ///< lowerBoundBytes
 };
 
 /// First index of part p of n cells in m parts, and the point range of the part
@@ -232,6 +322,17 @@ rankResult runRanks(const options& o, int P)
         auto lowestOwner = [&](const std::array<long, 3>& i) {
             std::array<int, 3> q = pr;
             for (int d = 0; d < 3; ++d) if (i[d] == lo[d] && pr[d] > 0) --q[d];
+            return q[0] + m[0]*(q[1] + m[1]*q[2]);
+        };
+        // the same for any grid point: per direction the first part whose points reach i
+        auto owner = [&](long i, long j, long k) {
+            const long idx[3] = {i, j, k};
+            int q[3];
+            for (int d = 0; d < 3; ++d)
+            {
+                q[d] = 0;
+                while (first(q[d] + 1, n, m[d]) < idx[d]) ++q[d];
+            }
             return q[0] + m[0]*(q[1] + m[1]*q[2]);
         };
         std::vector<point<3>> ctrl, eval;
@@ -283,6 +384,12 @@ rankResult runRanks(const options& o, int P)
             f.evalCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
         }
         const fitReport& rep = mba.report();
+        if (P > 1 && o.lowerBound)
+        {
+            std::vector<point<3>> query(ctrl);
+            query.insert(query.end(), eval.begin(), eval.end());
+            f.lowerBound = lowerBoundBytes(mba.dom(), rep.levels, n, query, r, owner);
+        }
         const trafficStats after = comm.traffic();
         f.bytes = double(after.bytesReceived - before.bytesReceived)/o.steps;
         f.messages = double(after.messagesReceived - before.messagesReceived)/o.steps;
@@ -347,6 +454,7 @@ int main(int argc, char** argv)
             const summary ev = over(v, [](const rankFigures& f) { return f.evalCpu; });
             const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
             const summary plan = over(v, [](const rankFigures& f) { return f.planCpu; });
+            const summary bound = over(v, [](const rankFigures& f) { return f.lowerBound; });
             // messages per neighbour and level: the bound the exchange keeps
             const summary perNb = over(v, [&](const rankFigures& f) {
                 return f.neighbours > 0 ? f.messages/(f.neighbours*res.levels) : 0.0;
@@ -362,11 +470,14 @@ int main(int argc, char** argv)
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
-                        "plan_cpu_max=%.4f max_residual=%.3e\n",
+                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f\n",
                         n, o.decomposition.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
-                        res.maxResidual);
+                        res.maxResidual, bound.max);
+            if (o.lowerBound && P > 1)
+                std::printf("  least any exchange of values per level could make the busiest rank receive: %.0f bytes, "
+                            "%.2f x the share\n", bound.max, bound.max/share);
             if (o.levels)
             {
                 std::printf("  levels of the rank receiving most: level, tiles received, ghosts received, "
