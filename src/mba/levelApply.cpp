@@ -373,9 +373,20 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
         sum.assign(n, 0.0);
         for (std::int64_t t = X.termsBegin[k]; t < X.termsBegin[k + 1]; ++t)
         {
-            const int r = X.terms[t].first;
-            const double* v = r == me ? ph : &recv_[r][X.terms[t].second];
-            for (std::size_t j = 0; j < n; ++j) sum[j] += v[j];
+            const chunkTerm& term = X.terms[t];
+            if (term.rank == me)
+            {
+                for (std::size_t j = 0; j < n; ++j) sum[j] += ph[j];
+                continue;
+            }
+            const double* v = &recv_[term.rank][term.offset];
+            for (std::int32_t q = term.runsBegin; q < term.runsEnd; ++q)
+            {
+                const nodeRun& run = X.termRuns[q];
+                double* to = &sum[std::size_t(run.node0 - X.owned[k].node0)*nc];
+                for (std::int32_t j = 0; j < run.nodes*nc; ++j) to[j] += v[j];
+                v += run.nodes*nc;
+            }
         }
         std::copy(sum.begin(), sum.end(), ph);
         divideByOmega(L, X.owned[k].tile*npt + X.owned[k].node0, X.owned[k].nodes);
