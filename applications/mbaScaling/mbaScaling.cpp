@@ -225,8 +225,14 @@ double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vect
         for (int d = 0; d < 3; ++d) for (long i = 0; i <= n; ++i) gb[d].push_back(base(d, i));
         const std::int64_t planeBase[2] = {gb[2][0], gb[2][n]};
         const std::int64_t nx = gb[0][n] + 4, ny = gb[1][n] + 4;
-        // the query points' nodes on the planes' four layers each: (plane, layer, x, y)
-        std::vector<std::uint8_t> needed(std::size_t(2*4*nx*ny), 0);
+        // the node layers (z) the planes' points touch, each once
+        std::vector<std::int64_t> zs;
+        for (int p = 0; p < 2; ++p) for (int l = 0; l < 4; ++l) zs.push_back(planeBase[p] + l);
+        std::sort(zs.begin(), zs.end());
+        zs.erase(std::unique(zs.begin(), zs.end()), zs.end());
+        const std::int64_t nz = std::int64_t(zs.size());
+        // the query points' nodes on those layers: (layer, y, x)
+        std::vector<std::uint8_t> needed(std::size_t(nz*nx*ny), 0);
         std::int64_t last[3] = {-1, -1, -1};
         for (const point<3>& x : query)
         {
@@ -235,17 +241,16 @@ double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vect
             const std::int64_t b[3] = {std::int64_t(u[0]), std::int64_t(u[1]), std::int64_t(u[2])};
             if (b[0] == last[0] && b[1] == last[1] && b[2] == last[2]) continue;
             std::copy(b, b + 3, last);
-            for (int p = 0; p < 2; ++p)
-                for (std::int64_t c = b[2]; c <= b[2] + 3; ++c)
-                {
-                    const std::int64_t layer = c - planeBase[p];   // node layer the plane's points touch: 0..3
-                    if (layer < 0 || layer > 3) continue;
-                    for (std::int64_t a1 = b[1]; a1 <= b[1] + 3; ++a1)
-                        for (std::int64_t a0 = b[0]; a0 <= b[0] + 3; ++a0)
-                            needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)] = 1;
-                }
+            for (std::int64_t z = 0; z < nz; ++z)
+            {
+                if (zs[z] < b[2] || zs[z] > b[2] + 3) continue;
+                for (std::int64_t a1 = b[1]; a1 <= b[1] + 3; ++a1)
+                    for (std::int64_t a0 = b[0]; a0 <= b[0] + 3; ++a0)
+                        needed[std::size_t((z*ny + a1)*nx + a0)] = 1;
+            }
         }
-        // per plane and node column (x, y): the grid points whose stencils hold it
+        // a needed node is remote when another rank's control point touches
+        // it (those points marked)
         std::vector<std::uint8_t> remotePoint(std::size_t(2*(n + 1)*(n + 1)), 0);
         double nodes = 0;
         auto range = [&](int d, std::int64_t a, long& i0, long& i1) {
@@ -254,28 +259,27 @@ double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vect
             i0 = long(std::lower_bound(g.begin(), g.end(), a - 3) - g.begin());
             i1 = long(std::upper_bound(g.begin(), g.end(), a) - g.begin()) - 1;
         };
-        for (int p = 0; p < 2; ++p)
+        for (std::int64_t z = 0; z < nz; ++z)
             for (std::int64_t a1 = 0; a1 < ny; ++a1)
                 for (std::int64_t a0 = 0; a0 < nx; ++a0)
                 {
-                    bool any = false;
-                    for (int layer = 0; layer < 4; ++layer)
-                        any = any || needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)];
-                    if (!any) continue;
+                    if (!needed[std::size_t((z*ny + a1)*nx + a0)]) continue;
                     long i0, i1, j0, j1;
                     range(0, a0, i0, i1);
                     range(1, a1, j0, j1);
                     bool remote = false;
-                    for (long j = j0; j <= j1; ++j)
-                        for (long i = i0; i <= i1; ++i)
-                            if (owner(i, j, p ? n : 0) != me)
-                            {
-                                remote = true;
-                                remotePoint[std::size_t((p*(n + 1) + j)*(n + 1) + i)] = 1;
-                            }
-                    if (!remote) continue;
-                    for (int layer = 0; layer < 4; ++layer)
-                        nodes += needed[std::size_t(((p*4 + layer)*ny + a1)*nx + a0)];
+                    for (int p = 0; p < 2; ++p)
+                    {
+                        if (zs[z] < planeBase[p] || zs[z] > planeBase[p] + 3) continue;
+                        for (long j = j0; j <= j1; ++j)
+                            for (long i = i0; i <= i1; ++i)
+                                if (owner(i, j, p ? n : 0) != me)
+                                {
+                                    remote = true;
+                                    remotePoint[std::size_t((p*(n + 1) + j)*(n + 1) + i)] = 1;
+                                }
+                    }
+                    nodes += remote;
                 }
         double points = 0;
         for (const std::uint8_t r : remotePoint) points += r;
