@@ -1,6 +1,7 @@
 """Strong-scaling model of the multilevel B-spline solve on the twisted cube.
 
     /usr/bin/python3 benchmarks/scalingModel.py RECORDS... [--real REAL] [--plot PNG] [--table]
+    /usr/bin/python3 benchmarks/scalingModel.py --traffic RECORDS...
 
 RECORDS are files with mbaScaling's RESULT lines (benchmarks/scaling writes
 them): per rank count and decomposition, the busiest rank's work (thread CPU
@@ -12,7 +13,7 @@ The model of one step on P ranks:
 
     T(P) = W(P) + R alpha + M o + B / beta + G 2 ceil(log2 P) alpha
 
-W: the busiest rank's work, measured on simulated ranks; R: exchange rounds
+W: the busiest rank's work (fit and evaluation), measured on simulated ranks; R: exchange rounds
 (one a direct level, two a chunked one; each a latency alpha, its messages in
 flight together); M, B: messages and bytes the busiest rank receives (o: the
 receiver's overhead per message, beta: the bandwidth); G: all-gathers (the
@@ -32,9 +33,14 @@ bytes scale with the boundary per rank, (m/n) times as much, the messages and
 rounds stay. Rank counts below the recorded ones take the serial work times
 (n/m)^3 (evaluation) and (n/m)^2 (fit).
 
---real REAL: key=value lines of real runs (ranks=, solve_s=: benchmarks/run's
-multilevelBSpline solve on the same mesh) to print beside the model.
+--real REAL: key=value lines of real runs (ranks=, solve_s=, fit_s=,
+evaluation_s=: benchmarks/run's multilevelBSpline on the 1M mesh, medians) to
+print beside the model of its smallest recorded size, slabs.
 --table: a markdown table of time per step, speed-up and efficiency.
+--traffic: only a markdown table of the records themselves: per rank count
+what the busiest rank receives (against its share of the boundary, 48 bytes
+per control point, and against the least possible, mbaScaling --lower-bound),
+its messages (also per neighbour and level), its work and the imbalance.
 """
 import math
 import sys
@@ -68,7 +74,7 @@ def read_records(paths):
 
 def step_time(rec, P, net):
     """Modelled seconds of one step of the busiest rank"""
-    work = rec["fit_cpu_max"] + rec["eval_cpu_max"]
+    work = rec["work_max"]
     if P == 1:
         return work
     comm = (rec["exchanges"]*net["alpha"] + rec["messages_max"]*net["o"] + rec["recv_bytes_max"]/net["beta"]
@@ -87,15 +93,17 @@ def scaled(records, n, ranks):
         if q < 1:
             if P == 1 and 1 in base:
                 r = dict(base[1])
-                r["fit_cpu_max"] *= 1/f**2
-                r["eval_cpu_max"] *= 1/f**3
+                r["work_max"] = r["fit_cpu_max"]/f**2 + r["eval_cpu_max"]/f**3
                 out[P] = r
             continue
         q = int(round(q))
         if q not in base:
             continue
         r = dict(base[q])
-        r["fit_cpu_max"] *= f
+        # the busiest rank's work with its fit part scaled (the ratio of its
+        # parts taken from the busiest fit and evaluation)
+        fit, ev = r["fit_cpu_max"], r["eval_cpu_max"]
+        r["work_max"] *= (f*fit + ev)/(fit + ev)
         r["recv_bytes_max"] *= f
         out[P] = r
     return out
@@ -117,6 +125,28 @@ def model(records, n, decomposition, net, ranks):
     return rows
 
 
+def traffic_table(records):
+    """Markdown: per size, decomposition and rank count, what the busiest rank receives and works"""
+    print("| cells | decomposition | ranks | parts | max control points of a rank | max neighbours "
+          "| max bytes received per step | / share | least possible / share | max messages received "
+          "| / (neighbours x levels) | fit s (max, mean) | evaluation s (max, mean) | imbalance |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
+    order = {"simple": 0, "hierarchical": 1, "columns": 2}
+    for (n, d) in sorted(records, key=lambda k: (k[0], order.get(k[1], 3), k[1])):
+        for P in sorted(records[(n, d)]):
+            r = records[(n, d)][P]
+            share = r["share_bytes"]
+            bound = r.get("lower_bound_max", 0)
+            print("| %.3gM | %s | %d | %s | %d | %d | %d | %s | %s | %d | %s | %.4f, %.4f | %.4f, %.4f | %.2f |" % (
+                n**3/1e6, names.get(d, d), P, r["parts"], r["ctrl_max"], r["neighbours_max"], r["recv_bytes_max"],
+                "%.2f" % (r["recv_bytes_max"]/share) if P > 1 else "-",
+                "%.2f" % (bound/share) if P > 1 and bound else "-", r["messages_max"],
+                "%.1f" % r["messages_per_neighbour_level_max"] if P > 1 else "-",
+                r["fit_cpu_max"], r["fit_cpu_mean"], r["eval_cpu_max"], r["eval_cpu_mean"],
+                r["work_max"]/r["work_mean"]))
+
+
 def main(argv):
     paths, real, plot, table = [], None, None, False
     i = 0
@@ -128,6 +158,9 @@ def main(argv):
             plot = argv[i + 1]; i += 2; continue
         if a == "--table":
             table = True; i += 1; continue
+        if a == "--traffic":
+            traffic_table(read_records(argv[i + 1:]))
+            return
         paths.append(a); i += 1
     if not paths:
         sys.exit(__doc__)
@@ -142,9 +175,8 @@ def main(argv):
                 if rows:
                     cases.append((n, decomposition, name, rows))
     for n, decomposition, name, rows in cases:
-        print("%d^3 cells (%.0fM), %s, %s:" % (n, decomposition and n**3/1e6, decomposition, name) if False else
-              "%d^3 = %.3gM cells, %s, %s%s:" % (n, n**3/1e6, decomposition, name,
-                                                   "" if (n, decomposition) in records else " (scaled)"))
+        print("%d^3 = %.3gM cells, %s, %s%s:" % (n, n**3/1e6, decomposition, name,
+                                                 "" if (n, decomposition) in records else " (scaled)"))
         if table:
             print("\n| ranks | s per step | speed-up | efficiency |\n|---|---|---|---|")
             for P, t, s, e in rows:
@@ -154,40 +186,69 @@ def main(argv):
             for P, t, s, e in rows:
                 print("  %4d ranks: %.5f s per step, speed-up %6.1f, efficiency %5.1f%%" % (P, t, s, 100*e))
     if real:
+        # the model's core (fit, evaluation, exchange) against the real runs'
+        # fit and evaluation (the solver's table: rank 0's, medians of the later steps)
         measured = {}
         with open(real) as f:
             for line in f:
                 kv = dict(x.split("=", 1) for x in line.split() if "=" in x)
-                if "ranks" in kv and "solve_s" in kv:
-                    measured[int(kv["ranks"])] = float(kv["solve_s"])
+                if "ranks" in kv and "fit_s" in kv:
+                    measured[int(kv["ranks"])] = kv
         n = min(sizes)
-        recs = records[(n, "simple")]
-        print("against real mpirun runs (%d^3 cells, slabs, sharedMemory network):" % n)
+        recs = records.get((n, "simple"), {})
+        print("\nagainst real mpirun runs (%d^3 cells, slabs; sharedMemory network):\n" % n)
+        print("| ranks | model: fit + evaluation + exchange s | real: fit + evaluation s | real solve s |")
+        print("|---|---|---|---|")
         for P in sorted(measured):
             if P in recs:
+                kv = measured[P]
                 t = step_time(recs[P], P, NETWORKS["sharedMemory"])
-                print("  %d ranks: model %.4f s (work %.4f), real solve %.4f s" %
-                      (P, t, recs[P]["fit_cpu_max"] + recs[P]["eval_cpu_max"], measured[P]))
+                print("| %d | %.4f | %.4f | %.4f |" % (P, t, float(kv["fit_s"]) + float(kv["evaluation_s"]),
+                                                   float(kv["solve_s"])))
+        if 1 in measured and 2 in measured and 1 in recs and 2 in recs:
+            em = step_time(recs[1], 1, NETWORKS["sharedMemory"])/(2*step_time(recs[2], 2, NETWORKS["sharedMemory"]))
+            core = lambda kv: float(kv["fit_s"]) + float(kv["evaluation_s"])
+            print("\n2-rank efficiency: model %.0f%%, real fit + evaluation %.0f%%, real solve %.0f%%" %
+                  (100*em, 100*core(measured[1])/(2*core(measured[2])),
+                   100*float(measured[1]["solve_s"])/(2*float(measured[2]["solve_s"]))))
     if plot:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-        for n, decomposition, name, rows in cases:
-            P = [r[0] for r in rows]
-            style = "-" if name == "infiniband" else "--"
-            label = "%.3gM cells, %s, %s" % (n**3/1e6, "slabs" if decomposition == "simple" else "boxes", name)
-            a1.loglog(P, [r[2] for r in rows], style, marker="o", ms=3, label=label)
-            a2.semilogx(P, [100*r[3] for r in rows], style, marker="o", ms=3, label=label)
-        a1.loglog([1, 256], [1, 256], "k:", lw=0.8, label="ideal")
-        a1.set_xlabel("ranks"); a1.set_ylabel("speed-up"); a1.set_title("Modelled strong scaling (twisted cube)")
-        a2.set_xlabel("ranks"); a2.set_ylabel("efficiency %"); a2.set_ylim(0, 105)
-        a2.axhline(80, color="k", lw=0.6, ls=":")
-        for a in (a1, a2):
-            a.set_xticks(ranks); a.set_xticklabels([str(r) for r in ranks]); a.grid(alpha=0.3)
-        a2.legend(fontsize=6.5, loc="lower left")
+        big = sorted({n for n, _, _, _ in cases if n >= 200})
+        fig, axes = plt.subplots(len(big), 2, figsize=(11, 4*len(big)), squeeze=False)
+        names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
+        colours = {"simple": "tab:red", "hierarchical": "tab:blue", "columns": "tab:green"}
+        for row, n in zip(axes, big):
+            a1, a2 = row
+            for m, decomposition, name, rows in cases:
+                if m != n:
+                    continue
+                P = [r[0] for r in rows]
+                style = "-" if name == "infiniband" else "--"
+                label = "%s, %s" % (names.get(decomposition, decomposition), name)
+                a1.loglog(P, [r[2] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3, label=label)
+                a2.semilogx(P, [100*r[3] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3,
+                            label=label)
+            scaledNote = "" if any((n, d) in records for d in names) else " (scaled from %d^3)" % max(sizes)
+            a1.loglog([1, 256], [1, 256], "k:", lw=0.8, label="ideal")
+            a1.set_title("%.3gM cells%s: modelled speed-up" % (n**3/1e6, scaledNote))
+            a2.set_title("%.3gM cells: modelled efficiency" % (n**3/1e6))
+            a1.set_ylabel("speed-up")
+            a2.set_ylabel("efficiency %")
+            a2.set_ylim(0, 115)
+            a2.axhline(80, color="k", lw=0.6, ls=":")
+            for a in (a1, a2):
+                a.set_xlabel("ranks")
+                a.set_xticks(ranks)
+                a.set_xticklabels([str(r) for r in ranks])
+                a.minorticks_off()
+                a.grid(alpha=0.3)
+            a2.legend(fontsize=7, loc="lower left")
+        fig.suptitle("Twisted cube, multilevelBSpline's fit, evaluation and exchange per step (benchmarks/scaling)",
+                     fontsize=10)
         fig.tight_layout()
-        fig.savefig(plot, dpi=110)
+        fig.savefig(plot, dpi=100)
         print("wrote", plot)
 
 
