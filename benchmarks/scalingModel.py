@@ -36,7 +36,9 @@ rounds stay. Rank counts below the recorded ones take the serial work times
 --real REAL: key=value lines of real runs (ranks=, solve_s=, fit_s=,
 evaluation_s=: benchmarks/run's multilevelBSpline on the 1M mesh, medians) to
 print beside the model of its smallest recorded size, slabs.
---table: a markdown table of time per step, speed-up and efficiency.
+Prints a summary (efficiency and time per step per rank count); --table adds
+a table of time per step, speed-up and efficiency per size, decomposition
+and network.
 --traffic: only a markdown table of the records themselves: per rank count
 what the busiest rank receives (against its share of the boundary, 48 bytes
 per control point, and against the least possible, mbaScaling --lower-bound),
@@ -174,17 +176,29 @@ def main(argv):
                 rows = model(records, n, decomposition, NETWORKS[name], ranks)
                 if rows:
                     cases.append((n, decomposition, name, rows))
+    # the summary: efficiency per rank count, per size, decomposition and network
+    names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
+    shown = [2, 8, 16, 32, 64, 128, 256]
+    print("| cells | decomposition | network | s per step on 1 rank | " +
+          " | ".join("%d ranks" % P for P in shown) + " |")
+    print("|---|---|---|---|" + "---|"*len(shown))
+    for n, decomposition, name, rows in sorted(cases, key=lambda c: (c[0], ["simple", "hierarchical", "columns"].index(c[1])
+                                                                        if c[1] in names else 3, c[2])):
+        by = {P: (t, e) for P, t, _, e in rows}
+        cell = lambda P: "%.0f%% (%.4f s)" % (100*by[P][1], by[P][0]) if P in by else "-"
+        print("| %.3gM%s | %s | %s | %.3f | %s |" % (n**3/1e6, "" if (n, decomposition) in records else " (scaled)",
+                                                  names.get(decomposition, decomposition), name, by[1][0],
+                                                  " | ".join(cell(P) for P in shown)))
+    print()
     for n, decomposition, name, rows in cases:
+        if not table:
+            break
         print("%d^3 = %.3gM cells, %s, %s%s:" % (n, n**3/1e6, decomposition, name,
                                                  "" if (n, decomposition) in records else " (scaled)"))
-        if table:
-            print("\n| ranks | s per step | speed-up | efficiency |\n|---|---|---|---|")
-            for P, t, s, e in rows:
-                print("| %d | %.4f | %.1f | %.0f%% |" % (P, t, s, 100*e))
-            print()
-        else:
-            for P, t, s, e in rows:
-                print("  %4d ranks: %.5f s per step, speed-up %6.1f, efficiency %5.1f%%" % (P, t, s, 100*e))
+        print("\n| ranks | s per step | speed-up | efficiency |\n|---|---|---|---|")
+        for P, t, s, e in rows:
+            print("| %d | %.4f | %.1f | %.0f%% |" % (P, t, s, 100*e))
+        print()
     if real:
         # the model's core (fit, evaluation, exchange) against the real runs'
         # fit and evaluation (the solver's table: rank 0's, medians of the later steps)
