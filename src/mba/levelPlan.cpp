@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 namespace mba {
 
@@ -83,7 +82,6 @@ class levelPlanner
     void findControlTiles();
     void testSeparation();
     void findGhostTiles();
-    chunkExchange planChunks() const;
     void chooseExchange();
     void fillStats();
 
@@ -429,135 +427,6 @@ void levelPlanner<D>::findGhostTiles()
     for (const auto& g : L_.ghostTiles) L_.hasGhosts = L_.hasGhosts || !g.empty();
 }
 
-/// Values (nc a node) of runs
-inline std::int64_t runValues(const std::vector<nodeRun>& runs, int nc)
-{
-    std::int64_t n = 0;
-    for (const nodeRun& r : runs) n += std::int64_t(r.nodes)*nc;
-    return n;
-}
-
-/// The chunked exchange (chunkExchange). Every rank that holds a tile in
-/// its view reads it, and asked every contributor for it: each knows the
-/// tile's contributors, hence every chunk's owner, and each owner knows the
-/// tile's readers (the ranks that asked it).
-template <int D>
-chunkExchange levelPlanner<D>::planChunks() const
-{
-    const std::int64_t nView = L_.view.size();
-    // contributors of each view tile (CSR), in rank order, with where their
-    // partial omega is (own id for this rank, else the position in what the
-    // rank sent); the readers of own tiles
-    std::vector<std::int64_t> cBegin(nView + 1, 0), rBegin(nView + 1, 0);
-    auto forContributors = [&](const std::function<void(std::int64_t, int, std::int64_t)>& f) {
-        for (int r = 0; r < nRanks_; ++r)
-        {
-            if (r == me_) for (std::int64_t o = 0; o < nOwn_; ++o) f(ownToView_[o], r, o);
-            else for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t) f(L_.tilesFrom[r][t], r, std::int64_t(t));
-        }
-    };
-    auto forReaders = [&](const std::function<void(std::int64_t, int)>& f) {
-        for (int r = 0; r < nRanks_; ++r) for (const std::int64_t id : L_.tilesTo[r]) f(id, r);
-    };
-    forContributors([&](std::int64_t id, int, std::int64_t) { ++cBegin[id + 1]; });
-    forReaders([&](std::int64_t id, int) { ++rBegin[id + 1]; });
-    for (std::int64_t id = 0; id < nView; ++id) { cBegin[id + 1] += cBegin[id]; rBegin[id + 1] += rBegin[id]; }
-    std::vector<int> contributors(cBegin[nView]), readers(rBegin[nView]);
-    std::vector<std::int64_t> where(cBegin[nView]);
-    {
-        std::vector<std::int64_t> cAt(cBegin.begin(), cBegin.end() - 1), rAt(rBegin.begin(), rBegin.end() - 1);
-        forContributors([&](std::int64_t id, int r, std::int64_t w) {
-            where[cAt[id]] = w;
-            contributors[cAt[id]++] = r;
-        });
-        forReaders([&](std::int64_t id, int r) { readers[rAt[id]++] = r; });
-    }
-    std::vector<std::int64_t> byKey;
-    for (std::int64_t id = 0; id < nView; ++id) if (cBegin[id + 1] > cBegin[id]) byKey.push_back(id);
-    std::sort(byKey.begin(), byKey.end(), [&](std::int64_t a, std::int64_t b) {
-        return L_.view.keyOf(a) < L_.view.keyOf(b);
-    });
-
-    // Only nodes with omega > 0 carry values: of a contributor's partial
-    // sums where its partial omega is (each side knows it: the plan sent
-    // it), of the sums where the sum of omega is (every reader has it)
-    const int per = omegaPerNode_;
-    auto anyPositive = [per](const double* o) {
-        for (int c = 0; c < per; ++c) if (o[c] > 0) return true;
-        return false;
-    };
-    auto partialOmega = [&](int r, std::int64_t w, int n) {
-        return r == me_ ? &ownOmega_[(w*npt + n)*per] : &omegaFrom_[r][(w*npt + n)*per];
-    };
-    // runs of the nodes [n0, n0 + nodes) of tile id where on(n), appended to out
-    auto maskedRuns = [](std::int64_t id, int n0, int nodes, const std::function<bool(int)>& on,
-                         std::vector<nodeRun>& out) {
-        for (int n = n0; n < n0 + nodes;)
-        {
-            if (!on(n)) { ++n; continue; }
-            int e = n + 1;
-            while (e < n0 + nodes && on(e)) ++e;
-            out.push_back(nodeRun{id, std::int32_t(n), std::int32_t(e - n)});
-            n = e;
-        }
-    };
-
-    chunkExchange X;
-    X.partialTo.assign(nRanks_, {});
-    X.fullTo.assign(nRanks_, {});
-    X.fullFrom.assign(nRanks_, {});
-    X.termsBegin.push_back(0);
-    std::vector<std::int64_t> offset(nRanks_, 0);   // values from each rank in round 1 so far
-    std::vector<nodeRun> runs;
-    for (const std::int64_t id : byKey)
-    {
-        const int* C = &contributors[cBegin[id]];
-        const std::int64_t* W = &where[cBegin[id]];
-        const std::int64_t m = cBegin[id + 1] - cBegin[id];
-        const std::int64_t self = std::find(C, C + m, me_) - C;   // m: not a contributor
-        const std::int64_t nChunks = std::min<std::int64_t>(m, npt), rot = std::int64_t(L_.view.keyOf(id) % m);
-        const auto summed = [&](int n) { return anyPositive(&L_.invOmega[(id*npt + n)*per]); };
-        for (std::int64_t j = 0; j < nChunks; ++j)
-        {
-            const int n0 = int(j*npt/nChunks), nodes = int((j + 1)*npt/nChunks - j*npt/nChunks);
-            const int owner = C[(j + rot) % m];
-            if (owner != me_)
-            {
-                if (self < m)
-                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(me_, W[self], n)); },
-                               X.partialTo[owner]);
-                maskedRuns(id, n0, nodes, summed, X.fullFrom[owner]);
-                continue;
-            }
-            X.owned.push_back(nodeRun{id, std::int32_t(n0), std::int32_t(nodes)});
-            for (std::int64_t c = 0; c < m; ++c)
-            {
-                chunkTerm term{C[c], -1, std::int32_t(X.termRuns.size()), std::int32_t(X.termRuns.size())};
-                if (C[c] != me_)
-                {
-                    runs.clear();
-                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(C[c], W[c], n)); }, runs);
-                    term.offset = offset[C[c]];
-                    for (const nodeRun& r : runs)
-                    {
-                        X.termRuns.push_back(r);
-                        offset[C[c]] += std::int64_t(r.nodes)*nc_;
-                    }
-                    term.runsEnd = std::int32_t(X.termRuns.size());
-                }
-                X.terms.push_back(term);
-            }
-            X.termsBegin.push_back(std::int64_t(X.terms.size()));
-            for (std::int64_t q = rBegin[id]; q < rBegin[id + 1]; ++q)
-                maskedRuns(id, n0, nodes, summed, X.fullTo[readers[q]]);
-        }
-    }
-    X.ownTiles = ownToView_;
-    X.partialCounts.assign(offset.begin(), offset.end());
-    for (int r = 0; r < nRanks_; ++r) X.fullCounts.push_back(std::size_t(runValues(X.fullFrom[r], nc_)));
-    return X;
-}
-
 /// Direct or chunked (params::exchange): automatic takes the chunks when
 /// the rank that receives most per apply then receives fewer bytes. A
 /// separated level stays direct (its apply stores phi where it is read).
@@ -565,7 +434,8 @@ template <int D>
 void levelPlanner<D>::chooseExchange()
 {
     if (mode_ == params::exchangeMode::direct || L_.separated) return;
-    chunkExchange X = planChunks();
+    chunkExchange X = planChunks<D>(chunkSources<D>{nRanks_, me_, nc_, omegaPerNode_, L_.view, ownToView_,
+        L_.tilesFrom, L_.tilesTo, ownOmega_, omegaFrom_, L_.invOmega});
     if (mode_ == params::exchangeMode::automatic)
     {
         std::int64_t direct = 0, chunked = 0;

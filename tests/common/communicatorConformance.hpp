@@ -90,6 +90,31 @@ inline void communicatorConformance(const mba::communicator& comm)
         }
     }
 
+    // the same into arrays sized by the receiver (no sizes travel), twice
+    // with the same arrays (as every apply of a plan does), the second time
+    // with other values
+    {
+        std::vector<std::vector<double>> send(P), recv(P);
+        for (int pass = 0; pass < 2; ++pass)
+        {
+            for (int q = 0; q < P; ++q)
+            {
+                send[q].clear();
+                if (q != me && (me + q) % 2 == 0)
+                    for (int i = 0; i < (me + 1)*(q + 1); ++i) send[q].push_back(1000.0*me + q + 1e-3*i + pass);
+                recv[q].assign(q != me && (me + q) % 2 == 0 ? std::size_t((q + 1)*(me + 1)) : 0, -1.0);
+            }
+            comm.exchange(send, recv);
+            for (int from = 0; from < P; ++from)
+            {
+                if (from == me || (me + from) % 2 != 0) { BSM_CHECK(recv[from].empty()); continue; }
+                BSM_REQUIRE(int(recv[from].size()) == (from + 1)*(me + 1));
+                for (int i = 0; i < int(recv[from].size()); ++i)
+                    BSM_CHECK(recv[from][i] == 1000.0*from + me + 1e-3*i + pass);
+            }
+        }
+    }
+
     // collective check: passes everywhere, or throws the same message on every rank
     {
         comm.check(true, "unused");   // must not throw

@@ -1,0 +1,163 @@
+// The chunked exchange's layout: the tiles' contributors and readers, then
+// the chunks, their owners and the node runs that travel.
+#include "chunkExchange.hpp"
+
+#include <algorithm>
+#include <functional>
+
+namespace mba {
+
+std::int64_t runValues(const std::vector<nodeRun>& runs, int nc)
+{
+    std::int64_t n = 0;
+    for (const nodeRun& r : runs) n += std::int64_t(r.nodes)*nc;
+    return n;
+}
+
+namespace {
+
+/// Per view tile (CSR): its contributors in rank order, with where their
+/// partial omega is (own id for this rank, else the position in what the
+/// rank sent), and the readers of own tiles; the tiles with contributors
+/// in key order (the order both sides of every message list them in)
+struct tileTable
+{
+    std::vector<std::int64_t> cBegin, rBegin;
+    std::vector<int> contributors, readers;
+    std::vector<std::int64_t> where;
+    std::vector<std::int64_t> byKey;
+};
+
+template <int D>
+tileTable makeTileTable(const chunkSources<D>& in)
+{
+    const std::int64_t nView = in.view.size();
+    tileTable T;
+    T.cBegin.assign(nView + 1, 0);
+    T.rBegin.assign(nView + 1, 0);
+    auto forContributors = [&](const std::function<void(std::int64_t, int, std::int64_t)>& f) {
+        for (int r = 0; r < in.nRanks; ++r)
+        {
+            if (r == in.me)
+                for (std::size_t o = 0; o < in.ownToView.size(); ++o) f(in.ownToView[o], r, std::int64_t(o));
+            else
+                for (std::size_t t = 0; t < in.tilesFrom[r].size(); ++t) f(in.tilesFrom[r][t], r, std::int64_t(t));
+        }
+    };
+    auto forReaders = [&](const std::function<void(std::int64_t, int)>& f) {
+        for (int r = 0; r < in.nRanks; ++r) for (const std::int64_t id : in.tilesTo[r]) f(id, r);
+    };
+    forContributors([&](std::int64_t id, int, std::int64_t) { ++T.cBegin[id + 1]; });
+    forReaders([&](std::int64_t id, int) { ++T.rBegin[id + 1]; });
+    for (std::int64_t id = 0; id < nView; ++id)
+    {
+        T.cBegin[id + 1] += T.cBegin[id];
+        T.rBegin[id + 1] += T.rBegin[id];
+    }
+    T.contributors.resize(T.cBegin[nView]);
+    T.where.resize(T.cBegin[nView]);
+    T.readers.resize(T.rBegin[nView]);
+    std::vector<std::int64_t> cAt(T.cBegin.begin(), T.cBegin.end() - 1), rAt(T.rBegin.begin(), T.rBegin.end() - 1);
+    forContributors([&](std::int64_t id, int r, std::int64_t w) {
+        T.where[cAt[id]] = w;
+        T.contributors[cAt[id]++] = r;
+    });
+    forReaders([&](std::int64_t id, int r) { T.readers[rAt[id]++] = r; });
+    for (std::int64_t id = 0; id < nView; ++id) if (T.cBegin[id + 1] > T.cBegin[id]) T.byKey.push_back(id);
+    std::sort(T.byKey.begin(), T.byKey.end(), [&](std::int64_t a, std::int64_t b) {
+        return in.view.keyOf(a) < in.view.keyOf(b);
+    });
+    return T;
+}
+
+/// The runs of the nodes [n0, n0 + nodes) of tile id where on(n), appended to out
+void maskedRuns(std::int64_t id, int n0, int nodes, const std::function<bool(int)>& on, std::vector<nodeRun>& out)
+{
+    for (int n = n0; n < n0 + nodes;)
+    {
+        if (!on(n)) { ++n; continue; }
+        int e = n + 1;
+        while (e < n0 + nodes && on(e)) ++e;
+        out.push_back(nodeRun{id, std::int32_t(n), std::int32_t(e - n)});
+        n = e;
+    }
+}
+
+} // namespace
+
+template <int D>
+chunkExchange planChunks(const chunkSources<D>& in)
+{
+    constexpr int npt = tileLayout<D>::nodesPerTile;
+    const tileTable T = makeTileTable(in);
+    // Only nodes with omega > 0 carry values: of a contributor's partial
+    // sums where its partial omega is (each side knows it: the plan sent
+    // it), of the sums where the sum of omega is (every reader has it)
+    const int per = in.omegaPerNode;
+    auto anyPositive = [per](const double* o) {
+        for (int c = 0; c < per; ++c) if (o[c] > 0) return true;
+        return false;
+    };
+    auto partialOmega = [&](int r, std::int64_t w, int n) {
+        return r == in.me ? &in.ownOmega[(w*npt + n)*per] : &in.omegaFrom[r][(w*npt + n)*per];
+    };
+    chunkExchange X;
+    X.partialTo.assign(in.nRanks, {});
+    X.fullTo.assign(in.nRanks, {});
+    X.fullFrom.assign(in.nRanks, {});
+    X.termsBegin.push_back(0);
+    std::vector<std::int64_t> offset(in.nRanks, 0);   // values from each rank in round 1 so far
+    std::vector<nodeRun> runs;
+    for (const std::int64_t id : T.byKey)
+    {
+        const int* C = &T.contributors[T.cBegin[id]];
+        const std::int64_t* W = &T.where[T.cBegin[id]];
+        const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
+        const std::int64_t self = std::find(C, C + m, in.me) - C;   // m: not a contributor
+        const std::int64_t nChunks = std::min<std::int64_t>(m, npt), rot = std::int64_t(in.view.keyOf(id) % m);
+        const auto summed = [&](int n) { return anyPositive(&in.invOmega[(id*npt + n)*per]); };
+        for (std::int64_t j = 0; j < nChunks; ++j)
+        {
+            const int n0 = int(j*npt/nChunks), nodes = int((j + 1)*npt/nChunks - j*npt/nChunks);
+            const int owner = C[(j + rot) % m];
+            if (owner != in.me)
+            {
+                if (self < m)
+                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(in.me, W[self], n)); },
+                               X.partialTo[owner]);
+                maskedRuns(id, n0, nodes, summed, X.fullFrom[owner]);
+                continue;
+            }
+            X.owned.push_back(nodeRun{id, std::int32_t(n0), std::int32_t(nodes)});
+            for (std::int64_t c = 0; c < m; ++c)
+            {
+                chunkTerm term{C[c], -1, std::int32_t(X.termRuns.size()), std::int32_t(X.termRuns.size())};
+                if (C[c] != in.me)
+                {
+                    runs.clear();
+                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(C[c], W[c], n)); }, runs);
+                    term.offset = offset[C[c]];
+                    for (const nodeRun& r : runs)
+                    {
+                        X.termRuns.push_back(r);
+                        offset[C[c]] += std::int64_t(r.nodes)*in.nc;
+                    }
+                    term.runsEnd = std::int32_t(X.termRuns.size());
+                }
+                X.terms.push_back(term);
+            }
+            X.termsBegin.push_back(std::int64_t(X.terms.size()));
+            for (std::int64_t q = T.rBegin[id]; q < T.rBegin[id + 1]; ++q)
+                maskedRuns(id, n0, nodes, summed, X.fullTo[T.readers[q]]);
+        }
+    }
+    X.ownTiles = in.ownToView;
+    X.partialCounts.assign(offset.begin(), offset.end());
+    for (int r = 0; r < in.nRanks; ++r) X.fullCounts.push_back(std::size_t(runValues(X.fullFrom[r], in.nc)));
+    return X;
+}
+
+template chunkExchange planChunks<2>(const chunkSources<2>&);
+template chunkExchange planChunks<3>(const chunkSources<3>&);
+
+} // namespace mba
