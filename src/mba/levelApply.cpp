@@ -168,7 +168,7 @@ void levelApplier<D>::clearLattice(levelPlan<D>& L) const
     if (L.chunked)
     {
         // the other tiles' nodes are all received (round 2) or never written
-        for (const std::int64_t id : L.chunks.ownTiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);
+        for (const std::int64_t id : L.chunks.ownTiles) std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
     }
     else if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
     else
@@ -352,7 +352,7 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
 {
     const int P = comm_.size(), me = comm_.rank(), nc = ctrl_.nComponents, npt = levelPlan<D>::npt;
     const chunkExchange& X = L.chunks;
-    auto at = [&](const nodeRun& r) { return &L.phi[(r.tile*npt + r.node0)*nc]; };
+    auto at = [&](const nodeRun& r) { return L.phi.data() + (r.tile*npt + r.node0)*nc; };
     auto exchange = [&](const std::vector<std::vector<nodeRun>>& runs, const std::vector<std::size_t>& counts) {
         send_.resize(P);
         recv_.resize(P);
@@ -379,7 +379,7 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
                 for (std::size_t j = 0; j < n; ++j) sum[j] += ph[j];
                 continue;
             }
-            const double* v = &recv_[term.rank][term.offset];
+            const double* v = recv_[term.rank].data() + term.offset;   // (no runs: maybe nothing received)
             for (std::int32_t q = term.runsBegin; q < term.runsEnd; ++q)
             {
                 const nodeRun& run = X.termRuns[q];
@@ -410,8 +410,8 @@ void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::in
 {
     const int nc = ctrl_.nComponents, per = ctrl_.omegaPerNode;
     if (n < 0) n = std::int64_t(L.invOmega.size())/per;
-    double* v = &L.phi[first*nc];
-    const double* s = &L.invOmega[first*per];
+    double* v = L.phi.data() + first*nc;
+    const double* s = L.invOmega.data() + first*per;
     switch (per == 1 ? nc : 1)
     {
         case 1: scaleNodes<1>(v, s, std::size_t(n*per)); break;
