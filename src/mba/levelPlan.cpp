@@ -230,25 +230,37 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
     std::vector<std::vector<std::uint64_t>> requests(nRanks_);
     std::vector<hashMap> requested(nRanks_);
     std::vector<std::size_t> hits;
+    std::vector<std::uint64_t> clusterTiles;
     for (std::size_t g = 0; g < qt.size() && !remote.empty(); ++g)
     {
         hits.clear();
         for (std::size_t b = 0; b < remote.size(); ++b) if (remote[b].intersects(qt[g])) hits.push_back(b);
         if (hits.empty()) continue;
+        // the cluster's stencil tiles, each once, in the order first met
+        // (the points of a cluster share most of their tiles)
+        hashMap seen;
+        clusterTiles.clear();
         for (const double* x : clusters_.points[g])
         {
             const point<D> u = scaled<D>(dom_.local0(x), L_.scale);
             forEachIndex<D>(stencil<D>(u.data()).tiles(), [&](const index<D>& t) {
-                for (const std::size_t b : hits)
-                {
-                    if (!remote[b].contains(t)) continue;
-                    const int r = remoteRank[b];
-                    const std::uint64_t key = L_.ownLayout.key(t);
-                    const std::size_t before = requested[r].size();
-                    requested[r].insert(key, 0);
-                    if (requested[r].size() != before) requests[r].push_back(key);
-                }
+                const std::uint64_t key = L_.ownLayout.key(t);
+                const std::size_t before = seen.size();
+                seen.insert(key, 0);
+                if (seen.size() != before) clusterTiles.push_back(key);
             });
+        }
+        for (const std::uint64_t key : clusterTiles)
+        {
+            const index<D> t = L_.ownLayout.coord(key);
+            for (const std::size_t b : hits)
+            {
+                if (!remote[b].contains(t)) continue;
+                const int r = remoteRank[b];
+                const std::size_t before = requested[r].size();
+                requested[r].insert(key, 0);
+                if (requested[r].size() != before) requests[r].push_back(key);
+            }
         }
     }
     return requests;
