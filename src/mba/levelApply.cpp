@@ -278,13 +278,14 @@ void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<dou
 /// Rank r's partial delta on the tiles received from it (dl), formed from
 /// its ghosts' residuals (got: nc a ghost) as r forms it: a run of points
 /// with the same stencil nodes is sent whole or not at all (its points
-/// touch the same tiles), and scattered as a run here as there
+/// touch the same tiles), and scattered as a run here as there (the ghosts
+/// say where r's runs begin)
 template <int D>
 void levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got,
                                        std::vector<double>& dl)
 {
     const int nc = ctrl_.nComponents, blk = levelPlan<D>::npt*nc;
-    const std::size_t stride = D + nc, ng = L.ghostTiles[r].size();
+    const std::size_t stride = D + nc + 1, ng = L.ghostTiles[r].size();
     const std::vector<stencil<D>>& st = L.ghostStencils[r];
     dl.assign(L.tilesFrom[r].size()*blk, 0.0);
     std::vector<double>& rr = ghostResiduals_;
@@ -307,7 +308,7 @@ void levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::
     }
     for (std::size_t g = 0, e; g < ng; g = e)
     {
-        for (e = g + 1; e < ng && st[e].base == st[g].base; ++e) {}
+        for (e = g + 1; e < ng && L.ghostsFrom[r][e*stride + D + nc] != 0; ++e) {}
         if (e - g >= minRun) scatterRun<D>(dl.data(), nc, L.ghostTiles[r][g], &st[g], &rr[g*nc], e - g);
         else for (std::size_t j = g; j < e; ++j) scatter<D>(dl.data(), nc, L.ghostTiles[r][j], st[j], &rr[j*nc]);
     }

@@ -304,14 +304,21 @@ void levelPlanner<D>::chooseGhosts()
         std::fill(asked.begin(), asked.end(), 0);
         for (const std::int64_t id : L_.tilesTo[r]) asked[id] = 1;
         std::vector<std::uint32_t> g;
+        std::vector<std::size_t> at;   // each ghost's position in order
         for (std::size_t q = 0; q < ctrl_.order.size(); ++q)
             for (const std::int32_t id : ownIds_[q])
-                if (id >= 0 && asked[id]) { g.push_back(ctrl_.order[q]); break; }
+                if (id >= 0 && asked[id]) { g.push_back(ctrl_.order[q]); at.push_back(q); break; }
         if (g.size() >= std::size_t(npt)*L_.tilesTo[r].size()) continue;
-        for (const std::uint32_t i : g)
+        for (std::size_t k = 0; k < g.size(); ++k)
         {
+            const std::uint32_t i = g[k];
             gx[r].insert(gx[r].end(), ctrl_.x[i], ctrl_.x[i] + D);
             for (int c = 0; c < nc_; ++c) gx[r].push_back(ctrl_.constrains(i, c) ? 1.0 : 0.0);
+            // it continues the previous ghost's run of equal stencils (the
+            // apply's runs: the point after it in order, with the same nodes)
+            const bool continues = k > 0 && at[k] == at[k - 1] + 1
+                && ctrl_.stencilAt(at[k], L_.scale).base == ctrl_.stencilAt(at[k - 1], L_.scale).base;
+            gx[r].push_back(continues ? 1.0 : 0.0);
         }
         L_.ghostsTo[r] = std::move(g);
     }
@@ -423,7 +430,7 @@ void levelPlanner<D>::findGhostTiles()
         if (L_.ghostsFrom[r].empty()) continue;
         std::vector<std::int32_t> at(L_.view.size(), -1);
         for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t) at[L_.tilesFrom[r][t]] = std::int32_t(t);
-        const std::size_t stride = D + nc_, ng = L_.ghostsFrom[r].size()/stride;
+        const std::size_t stride = D + nc_ + 1, ng = L_.ghostsFrom[r].size()/stride;
         L_.ghostTiles[r].resize(ng);
         for (std::size_t g = 0; g < ng; ++g)
         {

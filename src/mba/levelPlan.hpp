@@ -78,7 +78,9 @@ struct levelPlan
     std::vector<stencilTiles<D>> controlTiles; ///< the view tiles of the own control points' stencils, in order
 
     std::vector<std::vector<std::uint32_t>> ghostsTo; ///< per rank: own points whose residuals go there (ghost mode)
-    std::vector<std::vector<double>> ghostsFrom;      ///< per rank: its ghosts, D coordinates + nc mask flags each
+    /// per rank: its ghosts, D coordinates + nc mask flags + whether it
+    /// continues the previous ghost's run of equal stencils (1) each
+    std::vector<std::vector<double>> ghostsFrom;
     std::vector<std::vector<stencilTiles<D>>> ghostTiles; ///< per rank: its ghosts' tiles, as positions in tilesFrom
     /// per rank: its ghosts' stencils (weights cubed unless separated) and 1/sum(w^2)
     std::vector<std::vector<stencil<D>>> ghostStencils;

@@ -115,47 +115,4 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
 }
 
 
-void Foam::PstreamCommunicator::exchangeInPlace
-(
-    const std::vector<mba::constByteRange>& send,
-    const std::vector<mba::byteRange>& recv
-) const
-{
-    if (!Pstream::parRun())
-    {
-        return;
-    }
-    const label nProcs = size();
-    const label me = rank();
-    const label start = UPstream::nRequests();
-    for (label proci = 0; proci < nProcs; ++proci)
-    {
-        if (proci != me && recv[proci].size > 0)
-        {
-            UIPstream::read
-            (
-                Pstream::commsTypes::nonBlocking,
-                proci,
-                recv[proci].data,
-                std::streamsize(recv[proci].size)
-            );
-        }
-    }
-    for (label proci = 0; proci < nProcs; ++proci)
-    {
-        if (proci != me && send[proci].size > 0)
-        {
-            UOPstream::write
-            (
-                Pstream::commsTypes::nonBlocking,
-                proci,
-                send[proci].data,
-                std::streamsize(send[proci].size)
-            );
-        }
-    }
-    UPstream::waitRequests(start);
-}
-
-
 // ************************************************************************* //
