@@ -322,19 +322,15 @@ rankResult runRanks(const options& o, int P)
         const std::array<int, 3> pr{r % m[0], (r/m[0]) % m[1], r/(m[0]*m[1])};
         std::array<long, 3> lo, hi;
         for (int d = 0; d < 3; ++d) { lo[d] = first(pr[d], n, m[d]); hi[d] = first(pr[d] + 1, n, m[d]); }
-        // the lowest rank holding point index i in direction d: the part before when i starts this part
-        auto lowestOwner = [&](const std::array<long, 3>& i) {
-            std::array<int, 3> q = pr;
-            for (int d = 0; d < 3; ++d) if (i[d] == lo[d] && pr[d] > 0) --q[d];
-            return q[0] + m[0]*(q[1] + m[1]*q[2]);
-        };
-        // the same for any grid point: per direction the first part whose points reach i
+        // the lowest rank holding grid point (i, j, k): per direction the
+        // first part whose points [first(p), first(p + 1)] reach the index
         auto owner = [&](long i, long j, long k) {
             const long idx[3] = {i, j, k};
             int q[3];
             for (int d = 0; d < 3; ++d)
             {
-                q[d] = 0;
+                q[d] = int(std::min<long>(m[d] - 1, idx[d]*m[d]/n));
+                while (q[d] > 0 && first(q[d], n, m[d]) >= idx[d]) --q[d];
                 while (first(q[d] + 1, n, m[d]) < idx[d]) ++q[d];
             }
             return q[0] + m[0]*(q[1] + m[1]*q[2]);
@@ -347,7 +343,7 @@ rankResult runRanks(const options& o, int P)
                 {
                     const point<3> x{double(i)/n, double(j)/n, double(k)/n};
                     if (k != 0 && k != n) { eval.push_back(x); continue; }
-                    if (lowestOwner({i, j, k}) != r) continue;
+                    if (owner(i, j, k) != r) continue;
                     ctrl.push_back(x);
                     const point<3> d = displacement(x);
                     for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }

@@ -118,10 +118,10 @@ levelPlan<D> levelPlanner<D>::run(int k)
     testSeparation();
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
     findGhostTiles();
-    if (nRanks_ > 1) chooseExchange();
     L_.receiveCounts.assign(nRanks_, 0);
-    for (int r = 0; r < nRanks_ && nRanks_ > 1 && !L_.chunked; ++r)
+    for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
         L_.receiveCounts[r] = L_.ghostTiles[r].empty() ? L_.tilesFrom[r].size()*npt*nc_ : L_.ghostTiles[r].size()*nc_;
+    if (nRanks_ > 1) chooseExchange();
     L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
@@ -442,8 +442,6 @@ void levelPlanner<D>::findGhostTiles()
             L_.ghostScales[r].push_back(1/st.sumSquares());
         }
     }
-    for (const auto& g : L_.ghostsTo) L_.hasGhosts = L_.hasGhosts || !g.empty();
-    for (const auto& g : L_.ghostTiles) L_.hasGhosts = L_.hasGhosts || !g.empty();
 }
 
 /// Direct or chunked (params::exchange): automatic takes the chunks when
@@ -460,11 +458,9 @@ void levelPlanner<D>::chooseExchange()
         std::int64_t direct = 0, chunked = 0;
         for (int r = 0; r < nRanks_; ++r)
         {
-            direct += L_.ghostTiles[r].empty() ? std::int64_t(L_.tilesFrom[r].size())*npt*nc_
-                : std::int64_t(L_.ghostTiles[r].size())*nc_;
-            chunked += runValues(X.fullFrom[r], nc_);
+            direct += std::int64_t(L_.receiveCounts[r]);
+            chunked += std::int64_t(X.partialCounts[r] + X.fullCounts[r]);
         }
-        for (const std::size_t c : X.partialCounts) chunked += std::int64_t(c);
         if (!(comm_.max(double(chunked)) < comm_.max(double(direct)))) return;
     }
     L_.chunked = true;
@@ -474,7 +470,7 @@ void levelPlanner<D>::chooseExchange()
     L_.ghostTiles.assign(nRanks_, {});
     L_.ghostStencils.assign(nRanks_, {});
     L_.ghostScales.assign(nRanks_, {});
-    L_.hasGhosts = false;
+    L_.receiveCounts.assign(nRanks_, 0);
 }
 
 template <int D>
@@ -525,10 +521,8 @@ void levelPlanner<D>::fillStats()
         s.ghostsReceived += std::int64_t(L.ghostTiles[r].size());
         const std::int64_t vs = L.ghostsTo[r].empty() ? std::int64_t(L.tilesTo[r].size())*npt*nc_
             : std::int64_t(L.ghostsTo[r].size())*nc_;
-        const std::int64_t vr = L.ghostTiles[r].empty() ? std::int64_t(L.tilesFrom[r].size())*npt*nc_
-            : std::int64_t(L.ghostTiles[r].size())*nc_;
         s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
-        s.bytesReceivedPerApply += vr*std::int64_t(sizeof(double));
+        s.bytesReceivedPerApply += std::int64_t(L.receiveCounts[r]*sizeof(double));
         s.bytes += std::int64_t((L.ghostsFrom[r].capacity() + L.ghostScales[r].capacity())*sizeof(double)
             + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>) + L.ghostStencils[r].capacity()*sizeof(stencil<D>));
     }

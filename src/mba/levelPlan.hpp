@@ -71,7 +71,7 @@ struct levelPlan
 
     std::vector<std::vector<std::int64_t>> tilesTo;   ///< per rank: own tiles (view ids) whose partial sums it gets
     std::vector<std::vector<std::int64_t>> tilesFrom; ///< per rank: view tiles its partial sums arrive in
-    std::vector<std::size_t> receiveCounts;   ///< per rank: values it sends here per apply (direct exchange)
+    std::vector<std::size_t> receiveCounts;   ///< per rank: values it sends here per apply (direct exchange; 0 when chunked)
     /// Own tiles (view ids) that a lower rank also contributes to: this
     /// rank's partial sums there are set aside and added in rank order
     std::vector<std::int64_t> sharedWithLower;
@@ -85,7 +85,6 @@ struct levelPlan
     /// per rank: its ghosts' stencils (weights cubed unless separated) and 1/sum(w^2)
     std::vector<std::vector<stencil<D>>> ghostStencils;
     std::vector<std::vector<double>> ghostScales;
-    bool hasGhosts = false;         ///< this rank sends or receives ghosts at this level
 
     bool chunked = false;           ///< the partial sums meet in chunks (chunks), not directly
     chunkExchange chunks;

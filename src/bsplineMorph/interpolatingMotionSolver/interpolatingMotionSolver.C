@@ -422,14 +422,12 @@ void Foam::interpolatingMotionSolver::solve()
     {
         report = interpolateField(displacement, changed);
     }
-    scalar boundarySeconds = timer.elapsedTime();
+    const scalar beforeBoundary = timer.elapsedTime();
     moveBoundaryPoints(displacement);
-    boundarySeconds = timer.elapsedTime() - boundarySeconds;
     label nInvalid = 0;
     const scalar checkSeconds = checkCells(newPoints_, nInvalid);
-    scalar correctSeconds = timer.elapsedTime();
     correctBoundaryValues(displacement);
-    boundarySeconds += timer.elapsedTime() - correctSeconds;
+    const scalar boundarySeconds = timer.elapsedTime() - beforeBoundary - checkSeconds;
 
     if (!report.summary.empty())
     {
