@@ -48,6 +48,10 @@ import math
 import sys
 from collections import defaultdict
 
+# the decompositions as the tables name them, in the order they list them
+NAMES = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
+ORDER = {"simple": 0, "hierarchical": 1, "columns": 2}
+
 NETWORKS = {
     "infiniband": dict(alpha=2e-6, o=0.5e-6, beta=10e9),
     "ethernet25": dict(alpha=20e-6, o=2e-6, beta=3e9),
@@ -133,15 +137,13 @@ def traffic_table(records):
           "| max bytes received per step | / share | least possible / share | max messages received "
           "| / (neighbours x levels) | fit s (max, mean) | evaluation s (max, mean) | imbalance |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
-    order = {"simple": 0, "hierarchical": 1, "columns": 2}
-    for (n, d) in sorted(records, key=lambda k: (k[0], order.get(k[1], 3), k[1])):
+    for (n, d) in sorted(records, key=lambda k: (k[0], ORDER.get(k[1], 3), k[1])):
         for P in sorted(records[(n, d)]):
             r = records[(n, d)][P]
             share = r["share_bytes"]
             bound = r.get("lower_bound_max", 0)
             print("| %.3gM | %s | %d | %s | %d | %d | %d | %s | %s | %d | %s | %.4f, %.4f | %.4f, %.4f | %.2f |" % (
-                n**3/1e6, names.get(d, d), P, r["parts"], r["ctrl_max"], r["neighbours_max"], r["recv_bytes_max"],
+                n**3/1e6, NAMES.get(d, d), P, r["parts"], r["ctrl_max"], r["neighbours_max"], r["recv_bytes_max"],
                 "%.2f" % (r["recv_bytes_max"]/share) if P > 1 else "-",
                 "%.2f" % (bound/share) if P > 1 and bound else "-", r["messages_max"],
                 "%.1f" % r["messages_per_neighbour_level_max"] if P > 1 else "-",
@@ -177,22 +179,18 @@ def main(argv):
                 if rows:
                     cases.append((n, decomposition, name, rows))
     # the summary: efficiency per rank count, per size, decomposition and network
-    names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
     shown = [2, 8, 16, 32, 64, 128, 256]
     print("| cells | decomposition | network | s per step on 1 rank | " +
           " | ".join("%d ranks" % P for P in shown) + " |")
     print("|---|---|---|---|" + "---|"*len(shown))
-    for n, decomposition, name, rows in sorted(cases, key=lambda c: (c[0], ["simple", "hierarchical", "columns"].index(c[1])
-                                                                        if c[1] in names else 3, c[2])):
+    for n, decomposition, name, rows in sorted(cases, key=lambda c: (c[0], ORDER.get(c[1], 3), c[2])):
         by = {P: (t, e) for P, t, _, e in rows}
         cell = lambda P: "%.0f%% (%.4f s)" % (100*by[P][1], by[P][0]) if P in by else "-"
         print("| %.3gM%s | %s | %s | %.3f | %s |" % (n**3/1e6, "" if (n, decomposition) in records else " (scaled)",
-                                                  names.get(decomposition, decomposition), name, by[1][0],
+                                                  NAMES.get(decomposition, decomposition), name, by[1][0],
                                                   " | ".join(cell(P) for P in shown)))
     print()
-    for n, decomposition, name, rows in cases:
-        if not table:
-            break
+    for n, decomposition, name, rows in (cases if table else []):
         print("%d^3 = %.3gM cells, %s, %s%s:" % (n, n**3/1e6, decomposition, name,
                                                  "" if (n, decomposition) in records else " (scaled)"))
         print("\n| ranks | s per step | speed-up | efficiency |\n|---|---|---|---|")
@@ -231,7 +229,6 @@ def main(argv):
         import matplotlib.pyplot as plt
         big = sorted({n for n, _, _, _ in cases if n >= 200})
         fig, axes = plt.subplots(len(big), 2, figsize=(11, 4*len(big)), squeeze=False)
-        names = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
         colours = {"simple": "tab:red", "hierarchical": "tab:blue", "columns": "tab:green"}
         for row, n in zip(axes, big):
             a1, a2 = row
@@ -240,11 +237,11 @@ def main(argv):
                     continue
                 P = [r[0] for r in rows]
                 style = "-" if name == "infiniband" else "--"
-                label = "%s, %s" % (names.get(decomposition, decomposition), name)
+                label = "%s, %s" % (NAMES.get(decomposition, decomposition), name)
                 a1.loglog(P, [r[2] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3, label=label)
                 a2.semilogx(P, [100*r[3] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3,
                             label=label)
-            scaledNote = "" if any((n, d) in records for d in names) else " (scaled from %d^3)" % max(sizes)
+            scaledNote = "" if any((n, d) in records for d in NAMES) else " (scaled from %d^3)" % max(sizes)
             a1.loglog([1, 256], [1, 256], "k:", lw=0.8, label="ideal")
             a1.set_title("%.3gM cells%s: modelled speed-up" % (n**3/1e6, scaledNote))
             a2.set_title("%.3gM cells: modelled efficiency" % (n**3/1e6))
