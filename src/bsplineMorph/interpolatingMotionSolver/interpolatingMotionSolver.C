@@ -108,11 +108,24 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
 
 void Foam::interpolatingMotionSolver::setEvalPoints()
 {
-    const boolList& fixed = constraintsPtr_->fixed();
+    // The points the conditions do not fix, less the rigid layers' points
+    // within innerDistance that no condition constrains: those move with
+    // their wall whatever the interpolant gives them (the sliding ones are
+    // interpolated: they are projected, and may be feet or re-fit points)
+    const boundaryConstraints& bc = *constraintsPtr_;
+    const boolList& fixed = bc.fixed();
+    bitSet rigid(fixed.size());
+    if (rigidLayersPtr_)
+    {
+        rigidLayersPtr_->markRigid(rigid);
+    }
     DynamicList<label> points(fixed.size());
     forAll(fixed, pointi)
     {
-        if (!fixed[pointi]) points.append(pointi);
+        if (!fixed[pointi] && !(rigid.test(pointi) && !bc.constrains(pointi)))
+        {
+            points.append(pointi);
+        }
     }
     if (points == evalPoints_ && !evalXyz_.empty())
     {

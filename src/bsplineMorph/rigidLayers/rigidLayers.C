@@ -217,13 +217,13 @@ void Foam::rigidLayers::fitRotations
     const label nWall = wallPoints_.size();
     rotation_.setSize(nWall);
     rotation_ = Zero;
-    forAll(patchIDs_, k)
+    label wallFacei = 0;
+    for (const label patchi : patchIDs_)
     {
-        const polyPatch& pp = pbm[patchIDs_[k]];
-        const faceList& localFaces = pp.localFaces();
-        forAll(pp, facei)
+        for (const face& f : pbm[patchi])
         {
-            const face& f = pp[facei];
+            const label start = wallFaceStart_[wallFacei];
+            const label end = wallFaceStart_[++wallFacei];
             if (known && !std::all_of(f.begin(), f.end(), [&](label p) { return (*known)[p]; }))
             {
                 continue;
@@ -240,9 +240,9 @@ void Foam::rigidLayers::fitRotations
             const vector A0 = twiceArea(f, points0, nullptr);
             const vector A1 = twiceArea(f, points0, &displacement);
             M += (A1*A0)/(mag(A0) + VSMALL);
-            for (const label lp : localFaces[facei])
+            for (label i = start; i < end; ++i)
             {
-                rotation_[patchWall_[k][lp]] += M;
+                rotation_[wallFacePoints_[i]] += M;
             }
         }
     }
@@ -252,26 +252,31 @@ void Foam::rigidLayers::fitRotations
     // faces each): the rotations vary smoothly over about innerDistance of a
     // deforming wall, so that the rigid offsets under a crease do not cross;
     // a rigid motion still gives R times a sum of S, whose polar factor is R
+    // A sweep in two gathers: each face's sum of its points, then each
+    // point's sum of its faces' sums
+    const label nWallFaces = wallFaceStart_.size() - 1;
+    faceSums_.setSize(nWallFaces);
     for (label sweep = 0; sweep < nSmooth_; ++sweep)
     {
-        tensorField next(nWall, Zero);
-        forAll(patchIDs_, k)
+        for (label facei = 0; facei < nWallFaces; ++facei)
         {
-            for (const face& f : pbm[patchIDs_[k]].localFaces())
+            tensor sum(Zero);
+            for (label i = wallFaceStart_[facei]; i < wallFaceStart_[facei + 1]; ++i)
             {
-                tensor sum(Zero);
-                for (const label lp : f)
-                {
-                    sum += rotation_[patchWall_[k][lp]];
-                }
-                for (const label lp : f)
-                {
-                    next[patchWall_[k][lp]] += sum;
-                }
+                sum += rotation_[wallFacePoints_[i]];
             }
+            faceSums_[facei] = sum;
         }
-        syncTools::syncPointList(mesh_, wallPoints_, next, plusEqOp<tensor>(), tensor::zero);
-        rotation_.transfer(next);
+        for (label wi = 0; wi < nWall; ++wi)
+        {
+            tensor sum(Zero);
+            for (label i = wallPointStart_[wi]; i < wallPointStart_[wi + 1]; ++i)
+            {
+                sum += faceSums_[wallPointFaces_[i]];
+            }
+            rotation_[wi] = sum;
+        }
+        syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
     }
     for (tensor& R : rotation_)
     {
@@ -416,6 +421,18 @@ void Foam::rigidLayers::apply
             d[c] = solved[c] ? rigid[c] : 0;
         }
         newPoints[pointi] = points0[pointi] + d;
+    }
+}
+
+
+void Foam::rigidLayers::markRigid(bitSet& rigid) const
+{
+    forAll(zonePoints_, i)
+    {
+        if (zoneWeight_[i] == 1)
+        {
+            rigid.set(zonePoints_[i]);
+        }
     }
 }
 

@@ -95,8 +95,10 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallOf.insert(wallPoints_[i], i);
     }
-    // The smoothing of the rotations: as many rings of faces as make
-    // innerDistance (by the walls' mean edge length)
+    // The smoothing of the rotations: a sweep (each point gets the sums of
+    // its faces' points) spreads them by a variance of about half an edge
+    // squared, so (innerDistance/edge)^2 sweeps, by the walls' mean edge,
+    // smooth them over a standard deviation of about innerDistance/sqrt(2)
     scalar edgeSum = 0;
     label nEdges = 0;
     for (const label patchi : patchIDs_)
@@ -109,17 +111,42 @@ void Foam::rigidLayers::findWallPoints()
     }
     edgeSum = returnReduce(edgeSum, sumOp<scalar>());
     nEdges = returnReduce(nEdges, sumOp<label>());
-    nSmooth_ = nEdges && edgeSum > 0
-      ? min(label(std::ceil(innerDistance_*nEdges/edgeSum)), label(50)) : 0;
+    const scalar rings = nEdges && edgeSum > 0 ? innerDistance_*nEdges/edgeSum : 0;
+    nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
 
-    patchWall_.setSize(patchIDs_.size());
-    forAll(patchIDs_, k)
+    // Each listed face's points as indices into wallPoints_
+    DynamicList<label> start(1, 0);
+    DynamicList<label> facePoints;
+    for (const label patchi : patchIDs_)
     {
-        const labelList& meshPoints = pbm[patchIDs_[k]].meshPoints();
-        patchWall_[k].setSize(meshPoints.size());
-        forAll(meshPoints, i)
+        for (const face& f : pbm[patchi])
         {
-            patchWall_[k][i] = wallOf[meshPoints[i]];
+            for (const label pointi : f)
+            {
+                facePoints.append(wallOf[pointi]);
+            }
+            start.append(facePoints.size());
+        }
+    }
+    wallFaceStart_.transfer(start);
+    wallFacePoints_.transfer(facePoints);
+    // and each wall point's faces (counted, then filled in face order)
+    wallPointStart_ = labelList(wallPoints_.size() + 1, Zero);
+    for (const label wi : wallFacePoints_)
+    {
+        ++wallPointStart_[wi + 1];
+    }
+    for (label wi = 0; wi < wallPoints_.size(); ++wi)
+    {
+        wallPointStart_[wi + 1] += wallPointStart_[wi];
+    }
+    wallPointFaces_.setSize(wallFacePoints_.size());
+    labelList fill(SubList<label>(wallPointStart_, wallPoints_.size()));
+    for (label facei = 0; facei + 1 < wallFaceStart_.size(); ++facei)
+    {
+        for (label i = wallFaceStart_[facei]; i < wallFaceStart_[facei + 1]; ++i)
+        {
+            wallPointFaces_[fill[wallFacePoints_[i]]++] = facei;
         }
     }
 }
