@@ -58,6 +58,11 @@ namespace
 }
 
 
+// * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
+
+const Foam::label Foam::rigidLayers::maxSmooth;
+
+
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
@@ -248,35 +253,42 @@ void Foam::rigidLayers::fitRotations
     }
     // The sums of the ranks that share a point, the same on all of them
     syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
-    // Summed over the neighbouring faces again, nSmooth_ times (a ring of
+    // Averaged over the neighbouring faces again, nSmooth_ times (a ring of
     // faces each): the rotations vary smoothly over about innerDistance of a
     // deforming wall, so that the rigid offsets under a crease do not cross;
-    // a rigid motion still gives R times a sum of S, whose polar factor is R
-    // A sweep in two gathers: each face's sum of its points, then each
-    // point's sum of its faces' sums
+    // a rigid motion still gives R times a mean of S, whose polar factor is R.
+    // A sweep in two gathers: each face's mean of its points, then each
+    // point's mean of its faces' means (over all ranks' faces: summed, synced,
+    // then divided; means, so that hundreds of sweeps do not overflow)
     const label nWallFaces = wallFaceStart_.size() - 1;
-    faceSums_.setSize(nWallFaces);
+    faceMeans_.setSize(nWallFaces);
     for (label sweep = 0; sweep < nSmooth_; ++sweep)
     {
         for (label facei = 0; facei < nWallFaces; ++facei)
         {
+            const label start = wallFaceStart_[facei];
+            const label end = wallFaceStart_[facei + 1];
             tensor sum(Zero);
-            for (label i = wallFaceStart_[facei]; i < wallFaceStart_[facei + 1]; ++i)
+            for (label i = start; i < end; ++i)
             {
                 sum += rotation_[wallFacePoints_[i]];
             }
-            faceSums_[facei] = sum;
+            faceMeans_[facei] = sum/scalar(end - start);
         }
         for (label wi = 0; wi < nWall; ++wi)
         {
             tensor sum(Zero);
             for (label i = wallPointStart_[wi]; i < wallPointStart_[wi + 1]; ++i)
             {
-                sum += faceSums_[wallPointFaces_[i]];
+                sum += faceMeans_[wallPointFaces_[i]];
             }
             rotation_[wi] = sum;
         }
         syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
+        forAll(rotation_, wi)
+        {
+            rotation_[wi] *= wallPointWeight_[wi];
+        }
     }
     for (tensor& R : rotation_)
     {

@@ -140,6 +140,16 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallPointStart_[wi + 1] += wallPointStart_[wi];
     }
+    wallPointWeight_.setSize(wallPoints_.size());
+    forAll(wallPointWeight_, wi)
+    {
+        wallPointWeight_[wi] = wallPointStart_[wi + 1] - wallPointStart_[wi];
+    }
+    syncTools::syncPointList(mesh_, wallPoints_, wallPointWeight_, plusEqOp<scalar>(), scalar(0));
+    for (scalar& w : wallPointWeight_)
+    {
+        w = 1/w;
+    }
     wallPointFaces_.setSize(wallFacePoints_.size());
     labelList fill(SubList<label>(wallPointStart_, wallPoints_.size()));
     for (label facei = 0; facei + 1 < wallFaceStart_.size(); ++facei)
