@@ -303,17 +303,14 @@ void Foam::rigidLayers::findOutermost()
     // The rigid zone's outermost points off the patches (within
     // innerDistance, with an edge to a point beyond it): the interpolation's
     // extra control points
-    boolList inner(mesh_.nPoints(), false);
-    forAll(zonePoints_, i)
-    {
-        inner[zonePoints_[i]] = zoneWeight_[i] == 1;
-    }
+    bitSet inner(mesh_.nPoints());
+    markRigid(inner);
     labelList outermost(mesh_.nPoints(), 0);
     for (const edge& e : mesh_.edges())
     {
-        if (inner[e.first()] != inner[e.second()])
+        if (inner.test(e.first()) != inner.test(e.second()))
         {
-            outermost[inner[e.first()] ? e.first() : e.second()] = 1;
+            outermost[inner.test(e.first()) ? e.first() : e.second()] = 1;
         }
     }
     syncTools::syncPointList(mesh_, outermost, maxEqOp<label>(), label(0));
@@ -329,7 +326,7 @@ void Foam::rigidLayers::findOutermost()
     forAll(zonePoints_, i)
     {
         const label pointi = zonePoints_[i];
-        if (inner[pointi] && outermost[pointi] && !onPatch.test(pointi))
+        if (inner.test(pointi) && outermost[pointi] && !onPatch.test(pointi))
         {
             shell.append(i);
             shellPoints.append(pointi);
