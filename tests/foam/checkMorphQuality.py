@@ -18,6 +18,9 @@
         check morphQuality -layers 5 in DIR (serial) against the known
         change per layer, and the 2-rank runs in DIR-zSplit and
         DIR-checkerboard against serial
+    checkMorphQuality.py strain STRETCH FILE
+        check bin/strainAlongLine's output (FILE) up the line x = 1, y = 0.5
+        at time 4 against the stretch's known strain
 
 The tables are read by column name (bin/bsmdata.py); check() and the exit
 status as in checkPoints.py (1 on any failed check).
@@ -177,6 +180,21 @@ def checkLayers(stretch, shear, d):
         worst = max(largestDifference(serial[t], q.get(t)) for t in serial)
         check(worst < 1e-12, "%s: 2 ranks' morphQuality.dat equals serial (largest relative difference %.2e)" % (split, worst))
 
+def checkStrain(stretch, path):
+    """bin/strainAlongLine's output up the line x = 1, y = 0.5 at time 4: the
+    displacement along z is stretch z^2, so between points at z_a and z_b
+    the strain is stretch (z_a + z_b), and from z = 0 to 1 stretch on average
+    (the script prints positions and displacements to 1e-6, strains to 1e-4)"""
+    lines = open(path).read().splitlines()
+    rows = [l.split() for l in lines if not l.startswith("#")]
+    check(len(rows) == 5, "strain along the line: %d points, expected 5" % len(rows))
+    worst = max(abs(float(row[2]) - stretch*(float(prev[0]) + float(row[0]))) for prev, row in zip(rows, rows[1:]))
+    check(worst < 1e-4, "strain between neighbours: largest error %.1e (< 1e-4)" % worst)
+    worst = max(abs(float(row[1]) - stretch*float(row[0])**2) for row in rows)
+    check(worst < 1e-6, "displacement along the line: largest error %.1e (< 1e-6)" % worst)
+    mean = float(lines[-1].split(":")[1])
+    check(abs(mean - stretch) < 1e-4, "mean strain %.4f, expected %g" % (mean, stretch))
+
 def main():
     mode, args = sys.argv[1], sys.argv[2:]
     if mode == "checkerboard":
@@ -187,8 +205,10 @@ def main():
         checkTable(args[0], args[1])
     elif mode == "layers":
         checkLayers(float(args[0]), float(args[1]), args[2])
+    elif mode == "strain":
+        checkStrain(float(args[0]), args[1])
     else:
-        sys.exit("checkMorphQuality.py: unknown mode %s (checkerboard, motions, table, layers)" % mode)
+        sys.exit("checkMorphQuality.py: unknown mode %s (checkerboard, motions, table, layers, strain)" % mode)
     return 1 if failures else 0
 
 if __name__ == "__main__":
