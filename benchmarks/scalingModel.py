@@ -14,8 +14,9 @@ The model of one step on P ranks:
     T(P) = W(P) + R alpha + M o + B / beta + G 2 ceil(log2 P) alpha
 
 W: the busiest rank's work (fit and evaluation), measured on simulated ranks; R: exchange rounds
-(one a direct level, two a chunked one; each a latency alpha, its messages in
-flight together); M, B: messages and bytes the busiest rank receives (o: the
+(one a direct level, two a chunked one, 2 log2 P a tree one, two more where P
+is not a power of two; each a latency alpha, its messages in flight
+together); M, B: messages and bytes the busiest rank receives (o: the
 receiver's overhead per message, beta: the bandwidth); G: all-gathers (the
 residual each level; gatherList and scatterList: two trees of log2 P
 latencies). Efficiency: T(1)/(P T(P)). Networks (stated, not measured):

@@ -2,7 +2,7 @@
 // B-spline core on the twisted cube, on simulated ranks (OpenFOAM-free).
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
-//              [--levels] [--steps S] [--lower-bound]
+//              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -26,7 +26,8 @@
 // rank count and one RESULT line each (key=value), which benchmarks/scaling
 // reads; --levels adds the per-level exchange of the rank that receives most;
 // --lower-bound the least any exchange of values per level could receive
-// (lowerBoundBytes), against the share.
+// (lowerBoundBytes), against the share; --exchange the levels' exchange
+// (params::exchange; default automatic, the motion solver's).
 
 #include "multilevel.hpp"
 
@@ -55,13 +56,14 @@ struct options
     bool levels = false;
     bool lowerBound = false;
     int steps = 1;
+    params::exchangeMode exchange = params::exchangeMode::automatic;
 };
 
 [[noreturn]] void usage(const std::string& msg)
 {
     std::cerr << "mbaScaling: " << msg << "\n"
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
-        "                  [--levels] [--steps S] [--lower-bound]\n";
+        "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n";
     std::exit(2);
 }
 
@@ -107,6 +109,15 @@ options parse(int argc, char** argv)
             else if (a == "--levels") o.levels = true;
             else if (a == "--lower-bound") o.lowerBound = true;
             else if (a == "--steps") o.steps = std::stoi(val());
+            else if (a == "--exchange")
+            {
+                const std::string e = val();
+                if (e == "automatic") o.exchange = params::exchangeMode::automatic;
+                else if (e == "direct") o.exchange = params::exchangeMode::direct;
+                else if (e == "chunked") o.exchange = params::exchangeMode::chunked;
+                else if (e == "tree") o.exchange = params::exchangeMode::tree;
+                else usage("--exchange must be automatic, direct, chunked or tree");
+            }
             else usage("unknown option " + a);
         }
         catch (const std::logic_error&) { usage("bad value for " + a); }
@@ -313,6 +324,7 @@ rankResult runRanks(const options& o, int P)
     const std::array<int, 3> m = parts(P, o.decomposition);
     const long n = o.n;
     params prm;   // the motion solver's defaults
+    prm.exchange = o.exchange;
     rankResult res;
     res.ranks.resize(P);
     std::mutex mtx;
@@ -480,10 +492,12 @@ int main(int argc, char** argv)
                             "%.2f x the share\n", bound.max, bound.max/share);
             if (o.levels)
             {
-                std::printf("  levels of the rank receiving most: level, tiles received, ghosts received, "
+                std::printf("  levels of the rank receiving most: level, exchange, tiles received, ghosts received, "
                             "messages, bytes received\n");
                 for (const levelStats& s : res.busiestLevels)
-                    std::printf("  %5d %8lld %8lld %4lld %10lld\n", s.level, static_cast<long long>(s.tilesReceived),
+                    std::printf("  %5d %8s %8lld %8lld %4lld %10lld\n", s.level,
+                                s.separated ? "separate" : s.tree ? "tree" : s.chunked ? "chunked" : "direct",
+                                static_cast<long long>(s.tilesReceived),
                                 static_cast<long long>(s.ghostsReceived), static_cast<long long>(s.messagesReceived),
                                 static_cast<long long>(s.bytesReceivedPerApply));
             }

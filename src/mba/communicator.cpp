@@ -52,6 +52,15 @@ void communicator::exchangeInPlace(const std::vector<constByteRange>& send, cons
     }
 }
 
+void communicator::sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const
+{
+    std::vector<constByteRange> s(size(), constByteRange{nullptr, 0});
+    std::vector<byteRange> r(size(), byteRange{nullptr, 0});
+    if (to >= 0) s[to] = send;
+    if (from >= 0) r[from] = recv;
+    exchangeInPlace(s, r);
+}
+
 void communicator::check(bool ok, const std::string& msg) const
 {
     bytes mine;

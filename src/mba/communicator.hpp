@@ -60,6 +60,12 @@ protected:
     /// travel, nothing is allocated); size 0: no message; this rank's own
     /// entries are ignored. By default through exchangeBytes, sizes checked.
     virtual void exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const;
+    /// send goes to rank to and rank from's message comes into recv, whose
+    /// size this rank knows (a round of treeSum): one partner each way
+    /// (-1 or size 0: none). Collective in that every rank calls it the same
+    /// number of times; an implementation may let a rank without partners
+    /// return at once. By default through exchangeInPlace.
+    virtual void sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const;
 
 public:
     virtual ~communicator() = default;
@@ -133,6 +139,28 @@ public:
             }
         }
         exchangeInPlace(s, r);
+    }
+
+    /// n values to rank to and m from rank from (sendReceiveBytes; -1 or 0: none)
+    template <class T>
+    void sendReceive(int to, const T* send, std::size_t n, int from, T* recv, std::size_t m) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        constByteRange s{nullptr, 0};
+        byteRange r{nullptr, 0};
+        if (to >= 0 && to != rank() && n > 0)
+        {
+            s = constByteRange{reinterpret_cast<const char*>(send), n*sizeof(T)};
+            ++traffic_.messagesSent;
+            traffic_.bytesSent += s.size;
+        }
+        if (from >= 0 && from != rank() && m > 0)
+        {
+            r = byteRange{reinterpret_cast<char*>(recv), m*sizeof(T)};
+            ++traffic_.messagesReceived;
+            traffic_.bytesReceived += r.size;
+        }
+        sendReceiveBytes(s.size ? to : -1, s, r.size ? from : -1, r);
     }
 
     /// Element-wise sum over ranks, added in rank order: identical on every rank

@@ -2,6 +2,7 @@
 // its own), then the apply's steps in the order apply() runs them.
 #include "levelApply.hpp"
 #include "plainLattice.hpp"
+#include "treeSum.hpp"
 
 #include <algorithm>
 
@@ -151,6 +152,7 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
     if (comm_.size() > 1)
     {
         if (L.chunked) exchangeChunks(L);
+        else if (L.tree) exchangeInTree(L);
         else exchangePartialSums(L, residuals);
     }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
@@ -160,15 +162,16 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
 }
 
 /// Zero delta; of a separated level only the tiles that other ranks' values
-/// are added to, of a chunked one only the own tiles
+/// are added to, of a chunked or tree one only the own tiles
 template <int D>
 void levelApplier<D>::clearLattice(levelPlan<D>& L) const
 {
     const int blk = levelPlan<D>::npt*ctrl_.nComponents;
-    if (L.chunked)
+    if (L.chunked || L.tree)
     {
-        // the other tiles' nodes are all received (round 2) or never written
-        for (const std::int64_t id : L.chunks.ownTiles) std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
+        // the other tiles' nodes are all received (round 2, the tree) or never written
+        for (const std::int64_t id : L.chunked ? L.chunks.ownTiles : L.treeOwn)
+            std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
     }
     else if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
     else
@@ -404,6 +407,34 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
     }
 }
 
+/// The tree exchange (levelPlan::tree): the own partial sums at the nodes
+/// summed (where omega > 0) placed among the level's values of all ranks,
+/// summed over the ranks (treeSum), and every tile of the view taken from
+/// the sums (0 at its other nodes)
+template <int D>
+void levelApplier<D>::exchangeInTree(levelPlan<D>& L)
+{
+    const int nc = ctrl_.nComponents, npt = levelPlan<D>::npt;
+    const std::int64_t blk = npt*nc;
+    std::vector<double>& sums = treeSums_;
+    sums.assign(std::size_t(L.treeValues), 0.0);
+    auto forNodes = [&](std::int64_t id, auto f) {
+        double* v = sums.data() + L.treeStart[id];
+        for (int n = 0; n < npt; ++n)
+            if (L.treeNodes[id] >> n & 1)
+            {
+                f(L.phi.data() + id*blk + n*nc, v);
+                v += nc;
+            }
+    };
+    for (const std::int64_t id : L.treeOwn)
+        if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(ph, ph + nc, v); });
+    treeSum(comm_, sums, chunkSum_);
+    std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    for (std::int64_t id = 0; id < std::int64_t(L.treeStart.size()); ++id)
+        if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(v, v + nc, ph); });
+}
+
 /// phi = delta/omega: one 1/omega per node, or per value; of nodes
 /// [first, first + n) (default: all)
 template <int D>
@@ -464,7 +495,7 @@ std::int64_t levelApplier<D>::bytes() const
     for (const auto& v : recv_) buffers += std::int64_t(v.capacity());
     for (const auto& v : ghostSums_) buffers += std::int64_t(v.capacity());
     buffers += std::int64_t(ghostResiduals_.capacity());
-    return std::int64_t((scaledResiduals_.capacity() + setAside_.capacity() + chunkSum_.capacity() + buffers)*sizeof(double)
+    return std::int64_t((scaledResiduals_.capacity() + setAside_.capacity() + chunkSum_.capacity() + treeSums_.capacity() + buffers)*sizeof(double)
         + (stencils_.capacity() + cubedStencils_.capacity())*sizeof(stencil<D>));
 }
 

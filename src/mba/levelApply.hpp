@@ -2,9 +2,10 @@
 // The apply of one level, in every fit (the paper's Eq. 5-6): each control
 // point c with residual r_c and stencil weights w proposes phi_c = w
 // r_c/sum(w^2) to its 4^D nodes; this rank's partial sums delta = sum w^2
-// phi_c are formed on its view, the other ranks' added in rank order (their
-// tiles, or their ghosts' residuals, received), phi = delta/omega, and the
-// level's values are subtracted from the residuals.
+// phi_c are formed on its view, the other ranks' added (in rank order,
+// their tiles or their ghosts' residuals received, directly or in chunks;
+// or through a tree of the ranks), phi = delta/omega, and the level's
+// values are subtracted from the residuals.
 #ifndef MBA_LEVELAPPLY_HPP
 #define MBA_LEVELAPPLY_HPP
 
@@ -25,7 +26,8 @@ class levelApplier
     std::vector<double> scaledResiduals_;   ///< r/sum(w^2) per point x component (levels not separated)
     std::vector<double> levelValues_;       ///< the current level's values at the control points, in order
     std::vector<double> setAside_;          ///< own partial sums of the tiles shared with lower ranks
-    std::vector<double> chunkSum_;          ///< one chunk's sum (chunked exchange)
+    std::vector<double> chunkSum_;          ///< one chunk's sum (chunked exchange), a round's values (tree)
+    std::vector<double> treeSums_;          ///< the level's tiles of all ranks (tree exchange)
     std::vector<std::vector<double>> send_, recv_; ///< per rank: what goes there, what comes from there
     std::vector<std::vector<double>> ghostSums_;   ///< per rank: its partial sums formed from its ghosts
     std::vector<double> ghostResiduals_;           ///< a rank's ghosts' r/sum(w^2)
@@ -38,6 +40,7 @@ class levelApplier
     void ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got, std::vector<double>& dl);
     void addInRankOrder(levelPlan<D>& L, const std::vector<const double*>& got);
     void exchangeChunks(levelPlan<D>& L);
+    void exchangeInTree(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L, std::int64_t first = 0, std::int64_t n = -1) const;
     void subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals);
 

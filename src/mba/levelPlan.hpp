@@ -89,6 +89,15 @@ struct levelPlan
     bool chunked = false;           ///< the partial sums meet in chunks (chunks), not directly
     chunkExchange chunks;
 
+    /// The partial sums meet in a tree of all ranks (treeSum): the values at
+    /// the nodes where omega > 0 of the level's tiles of every rank, in key
+    /// order, nodes in order
+    bool tree = false;
+    std::int64_t treeValues = 0;            ///< tree: values summed
+    std::vector<std::int64_t> treeStart;    ///< tree: per view tile, where its values start (-1: none)
+    std::vector<std::uint64_t> treeNodes;   ///< tree: per view tile, its nodes among them (bit n: node n)
+    std::vector<std::int64_t> treeOwn;      ///< tree: the own tiles (view ids)
+
     levelStats stats;
 
     /// The layout of the own tiles

@@ -58,16 +58,25 @@ struct params
     double padding = 1e-3;
     /// Target number of tiles per exchange bucket (>= 1)
     int bucketTiles = 32;
-    /// How a level's partial sums meet (parallel only; every choice sums in
-    /// rank order and gives the same values): direct (every contributor
-    /// sends its partial sums, or the residuals of its points near them, to
-    /// every rank that reads them), chunked (each shared tile's nodes are
-    /// split into chunks, one per contributor, which sums that chunk and
-    /// sends it to the tile's readers: what a rank receives is bounded by the
-    /// tiles it reads, however many ranks contribute), or automatic (per
-    /// level the one whose busiest rank receives fewer bytes). Levels whose
-    /// control points are separated always exchange directly.
-    enum class exchangeMode { automatic, direct, chunked };
+    /// How a level's partial sums meet (parallel only): direct (every
+    /// contributor sends its partial sums, or the residuals of its points
+    /// near them, to every rank that reads them), chunked (each shared
+    /// tile's nodes are split into chunks, one per contributor, which sums
+    /// that chunk and sends it to the tile's readers: what a rank receives is
+    /// bounded by the tiles it reads, however many ranks contribute), tree
+    /// (the level's tiles of all ranks summed through a binary tree of the
+    /// ranks, treeSum.hpp: 2 log2(P) messages a rank, about twice the
+    /// level's tiles received; it gathers the level's tile keys once) or
+    /// automatic (per level, chunked where it makes the busiest rank receive
+    /// fewer bytes than direct, and tree where it makes the level's exchange
+    /// cheaper than that choice in a latency-bandwidth model with
+    /// InfiniBand-class parameters, which happens on coarse levels that
+    /// many ranks share). Direct and chunked sum in rank order and give the
+    /// same values bit for bit; tree sums in its tree's order (equal to
+    /// round-off). Every choice gives every rank that holds a node the same
+    /// value. Levels whose control points are separated always exchange
+    /// directly.
+    enum class exchangeMode { automatic, direct, chunked, tree };
     exchangeMode exchange = exchangeMode::automatic;
 
     /// Throws std::invalid_argument naming the offending parameter
@@ -90,6 +99,7 @@ struct levelStats
     std::int64_t ghostsSent = 0, ghostsReceived = 0; ///< control points whose residuals are sent instead of tiles
     std::int64_t messagesSent = 0, messagesReceived = 0;
     bool chunked = false;                 ///< the level's partial sums meet in chunks (params::exchange)
+    bool tree = false;                    ///< the level's partial sums meet in a tree of the ranks (params::exchange)
     std::int64_t bytesSentPerApply = 0, bytesReceivedPerApply = 0;
     double maxResidual = 0, rmsResidual = 0; ///< after this level (global)
     double seconds = 0;                   ///< time of the last apply of this level

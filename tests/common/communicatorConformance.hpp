@@ -115,6 +115,27 @@ inline void communicatorConformance(const mba::communicator& comm)
         }
     }
 
+    // one partner each way (a round of treeSum): along a ring, rank me sends
+    // me + 1 values to the next and receives from the previous; then the
+    // last rank sits a round out (its neighbours skip it), twice over
+    if (P > 1)
+    {
+        const int next = (me + 1) % P, prev = (me + P - 1) % P;
+        std::vector<double> send(me + 1), recv(prev + 1, -1.0);
+        for (int i = 0; i <= me; ++i) send[i] = 100.0*me + i;
+        comm.sendReceive(next, send.data(), send.size(), prev, recv.data(), recv.size());
+        for (int i = 0; i <= prev; ++i) BSM_CHECK(recv[i] == 100.0*prev + i);
+        for (int pass = 0; pass < 2; ++pass)
+        {
+            const bool out = me == P - 1, toOut = next == P - 1, fromOut = prev == P - 1;
+            const int to = out || toOut ? -1 : next, from = out || fromOut ? -1 : prev;
+            std::vector<double> got(from >= 0 ? std::size_t(prev + 1) : 0, -1.0);
+            for (int i = 0; i <= me; ++i) send[i] = 100.0*me + i + pass;
+            comm.sendReceive(to, send.data(), to >= 0 ? send.size() : 0, from, got.data(), got.size());
+            for (std::size_t i = 0; i < got.size(); ++i) BSM_CHECK(got[i] == 100.0*prev + double(i) + pass);
+        }
+    }
+
     // collective check: passes everywhere, or throws the same message on every rank
     {
         comm.check(true, "unused");   // must not throw

@@ -3,6 +3,7 @@
 // communicator conformance suite for the serial and simulated implementations.
 #include "communicatorConformance.hpp"
 #include "testData.hpp"
+#include "treeSum.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -189,6 +190,7 @@ TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many
     {
         problem pb;
         pb.p.tolerance = 1e-8;
+        pb.p.exchange = params::exchangeMode::chunked;
         std::vector<std::vector<levelStats>> st(P);
         pb.stats = &st;
         solve<3>(P, partition::slabs, c, v, {}, e, pb);
@@ -200,6 +202,108 @@ TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many
             CHECK(st[r][0].bytesReceivedPerApply >= tile*(P - 1)/P);
         }
     }
+}
+
+TEST_CASE("tree sum: the same bits on every rank, one message a round", "[parallel][tree]")
+{
+    const int P = GENERATE(2, 3, 5, 6, 7, 8, 16);
+    const std::size_t n = GENERATE(std::size_t(0), std::size_t(5), std::size_t(1000));
+    int p2 = 1;
+    while (2*p2 <= P) p2 *= 2;
+    int log2p2 = 0;
+    while ((1 << log2p2) < p2) ++log2p2;
+    std::vector<std::vector<double>> exact(P), rounded(P);
+    std::vector<std::uint64_t> received(P);
+    runSimulated(P, [&](const communicator& comm) {
+        std::mt19937 rng(1000 + unsigned(comm.rank()));
+        std::uniform_real_distribution<double> u(-1, 1);
+        std::vector<double> a(n), b(n);
+        for (std::size_t i = 0; i < n; ++i)
+        {
+            a[i] = double((i + 1)*(comm.rank() + 1));   // sums exact in any order
+            b[i] = u(rng)*std::pow(10.0, int(rng() % 9) - 4);   // sums that depend on the order
+        }
+        std::vector<double> work;
+        const std::uint64_t before = comm.traffic().messagesReceived;
+        treeSum(comm, a, work);
+        received[comm.rank()] = comm.traffic().messagesReceived - before;
+        treeSum(comm, b, work);
+        exact[comm.rank()] = a;
+        rounded[comm.rank()] = b;
+    });
+    INFO(P << " ranks, " << n << " values");
+    for (std::size_t i = 0; i < n; ++i) REQUIRE(exact[0][i] == double((i + 1)*P*(P + 1)/2));
+    for (int r = 0; r < P; ++r)
+    {
+        INFO("rank " << r);
+        CHECK(exact[r] == exact[0]);
+        CHECK(rounded[r] == rounded[0]);
+        // one message a halving and a doubling round, and one more where P
+        // is not a power of two (n = 5 leaves some halves empty: no message)
+        CHECK(received[r] <= std::uint64_t(2*log2p2 + (P > p2)));
+        if (n >= std::size_t(p2)) CHECK(received[r] >= std::uint64_t(r < p2 ? 2*log2p2 : 1));
+    }
+}
+
+TEST_CASE("tree exchange: serial's values, 2 log2(P) messages a rank on a level", "[parallel][tree]")
+{
+    const bool surface = GENERATE(true, false);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    const auto c = surface ? surfacePoints<3>(14) : randomPoints<3>(1500, 75);
+    const auto e = randomPoints<3>(1500, 73);
+    problem pb;
+    pb.p.tolerance = 1e-9;
+    pb.p.bucketTiles = 8;
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    const std::vector<double> ref = solve<3>(1, how, c, v, {}, e, pb);
+    for (const int P : {2, 3, 5, 8, 16})
+    {
+        INFO("ranks " << P << ", surface " << surface << ", partition " << name(how));
+        std::vector<std::vector<levelStats>> st(P);
+        pb.stats = &st;
+        pb.p.exchange = params::exchangeMode::tree;
+        const std::vector<double> tree = solve<3>(P, how, c, v, {}, e, pb);
+        int p2 = 1, log2p2 = 0;
+        while (2*p2 <= P) p2 *= 2, ++log2p2;
+        int treeLevels = 0;
+        for (const levelStats& s : st[0]) treeLevels += s.tree;
+        CHECK(treeLevels >= 4);
+        for (int r = 0; r < P; ++r)
+            for (const levelStats& s : st[r])
+                if (s.tree) CHECK(s.messagesReceived <= 2*log2p2 + (P > p2));
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(tree[i] - ref[i]));
+        CHECK(diff <= 1e-12*maxAbs(v));
+    }
+}
+
+TEST_CASE("automatic exchange: the tree on the coarse levels that 64 slabs share, chunks or direct below", "[parallel][tree]")
+{
+    // level 0 is one tile that every rank contributes to and reads: directly
+    // each rank would receive 63 messages, in chunks 2 x 63, through the
+    // tree 12 (in 12 rounds instead of one or two: in the model of
+    // levelPlanner::exchangeCost the tree is cheaper from about 40 ranks)
+    const auto c = surfacePoints<3>(65);   // every slab holds control points
+    const auto e = randomPoints<3>(3000, 74);
+    const auto v = smoothValues<3>(c, 3);
+    problem pb;
+    pb.p.tolerance = 1e-8;
+    const std::vector<double> ref = solve<3>(1, partition::slabs, c, v, {}, e, pb);
+    const int P = 64;
+    std::vector<std::vector<levelStats>> st(P);
+    pb.stats = &st;
+    const std::vector<double> got = solve<3>(P, partition::slabs, c, v, {}, e, pb);
+    for (int r = 0; r < P; ++r)
+    {
+        INFO("rank " << r);
+        REQUIRE(st[r][0].tree);
+        CHECK(st[r][0].messagesReceived == 12);
+        for (const levelStats& s : st[r]) CHECK(s.tree == st[0][s.level].tree);   // the same choice on every rank
+        CHECK(!st[r].back().tree);
+    }
+    double diff = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+    CHECK(diff <= 1e-12*maxAbs(v));
 }
 
 TEST_CASE("levels that separate the control points: serial equals simulated ranks", "[parallel]")
@@ -285,7 +389,9 @@ TEST_CASE("a point evaluated on several ranks gets bitwise the same value", "[pa
     const auto v = smoothValues<3>(c, 3);
     params p;
     p.tolerance = 1e-9;
-    const int P = 4;
+    p.exchange = GENERATE(params::exchangeMode::direct, params::exchangeMode::chunked, params::exchangeMode::tree);
+    INFO("exchange " << int(p.exchange));
+    const int P = GENERATE(4, 5);
     std::vector<std::vector<double>> got(P);
     runSimulated(P, [&](const communicator& comm) {
         std::vector<point<3>> cl;

@@ -281,7 +281,7 @@ TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bs
     CHECK_THAT(inverted, Contains("maybe") && Contains("fatal") && Contains("warn"));
     CHECK_THAT(errorOf("relativeTolerance perhaps;"), Contains("perhaps"));
     const std::string exchange = errorOf("exchange sideways;");
-    CHECK_THAT(exchange, Contains("sideways") && Contains("automatic") && Contains("direct") && Contains("chunked"));
+    CHECK_THAT(exchange, Contains("sideways") && Contains("automatic") && Contains("direct") && Contains("chunked") && Contains("tree"));
     CHECK(errorOf("tolerance 1e-8; maxLevels 8; initialGrid 2; initialApproximation none;") == "no error");
 }
 

@@ -36,6 +36,9 @@ namespace
     {
         return mba::bytes(l.begin(), l.end());
     }
+
+    //- The tag of sendReceiveBytes' messages: none of OpenFOAM's
+    const int sendReceiveTag = 28002;
 }
 
 
@@ -112,6 +115,45 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
         }
     }
     return got;
+}
+
+
+void Foam::PstreamCommunicator::sendReceiveBytes
+(
+    int to,
+    mba::constByteRange send,
+    int from,
+    mba::byteRange recv
+) const
+{
+    if (!Pstream::parRun())
+    {
+        return;
+    }
+    const label start = UPstream::nRequests();
+    if (from >= 0 && recv.size > 0)
+    {
+        UIPstream::read
+        (
+            Pstream::commsTypes::nonBlocking,
+            from,
+            recv.data,
+            std::streamsize(recv.size),
+            sendReceiveTag
+        );
+    }
+    if (to >= 0 && send.size > 0)
+    {
+        UOPstream::write
+        (
+            Pstream::commsTypes::nonBlocking,
+            to,
+            send.data,
+            std::streamsize(send.size),
+            sendReceiveTag
+        );
+    }
+    UPstream::waitRequests(start);
 }
 
 

@@ -56,6 +56,7 @@ namespace Foam
             { mba::params::exchangeMode::automatic, "automatic" },
             { mba::params::exchangeMode::direct, "direct" },
             { mba::params::exchangeMode::chunked, "chunked" },
+            { mba::params::exchangeMode::tree, "tree" },
         });
 
         //- The control points of bc (points0 in the solution directions,
@@ -146,13 +147,14 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     const mba::fitReport& r = plan_.report();
     const word& type = multilevelBSplineMotionSolver::typeName;
     double nodes = 0, bytes = 0, messages = 0;
-    label separated = 0, chunked = 0;
+    label separated = 0, chunked = 0, tree = 0;
     for (const mba::levelStats& s : plan_.stats())
     {
         if (s.level < r.levels)
         {
             separated += s.separated;
             chunked += s.chunked;
+            tree += s.tree;
             nodes += s.nodes;
             bytes += s.bytesReceivedPerApply;
             messages += s.messagesReceived;
@@ -161,7 +163,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
                 Pout<< type << ": level " << s.level << " h " << s.h << " nodes " << s.nodes
                     << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
                     << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
-                    << (s.chunked ? " chunked" : "")
+                    << (s.chunked ? " chunked" : "") << (s.tree ? " tree" : "")
                     << " received " << s.bytesReceivedPerApply
                     << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
                     << s.planSeconds << " s)" << endl;
@@ -186,6 +188,10 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     if (Pstream::parRun())
     {
         os  << ", " << chunked << " chunked";
+        if (tree)
+        {
+            os  << ", " << tree << " tree";
+        }
     }
     os  << "), max residual " << r.maxResidual
         << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
@@ -198,6 +204,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     report.add("levels", r.levels);
     report.add("separatedLevels", separated);
     report.add("chunkedLevels", chunked);
+    report.add("treeLevels", tree);
     report.add("maxResidual", r.maxResidual);
     report.add("threshold", r.threshold);
     report.add("converged", r.converged);
