@@ -245,24 +245,29 @@ TEST_CASE("tree sum: the same bits on every rank, one message a round", "[parall
     }
 }
 
-TEST_CASE("tree exchange: serial's values, 2 log2(P) messages a rank on a level", "[parallel][tree]")
+namespace {
+
+/// The tree exchange on P ranks against serial (1e-12), with at most one
+/// message a round on each tree level
+template <int D>
+void treeEqualsSerial(bool surface, bool masked, partition how, const std::vector<int>& ranks)
 {
-    const bool surface = GENERATE(true, false);
-    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
-    const auto c = surface ? surfacePoints<3>(14) : randomPoints<3>(1500, 75);
-    const auto e = randomPoints<3>(1500, 73);
+    const auto c = surface ? surfacePoints<D>(D == 3 ? 14 : 60) : randomPoints<D>(D == 3 ? 1500 : 600, 75);
+    const auto e = randomPoints<D>(1500, 73);
     problem pb;
     pb.p.tolerance = 1e-9;
     pb.p.bucketTiles = 8;
-    const std::vector<double> v = smoothValues<3>(c, pb.nc);
-    const std::vector<double> ref = solve<3>(1, how, c, v, {}, e, pb);
-    for (const int P : {2, 3, 5, 8, 16})
+    const std::vector<double> v = smoothValues<D>(c, pb.nc);
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
+    const std::vector<double> ref = solve<D>(1, how, c, v, mask, e, pb);
+    for (const int P : ranks)
     {
-        INFO("ranks " << P << ", surface " << surface << ", partition " << name(how));
+        INFO("D " << D << ", ranks " << P << ", surface " << surface << ", masked " << masked << ", partition "
+             << name(how));
         std::vector<std::vector<levelStats>> st(P);
         pb.stats = &st;
         pb.p.exchange = params::exchangeMode::tree;
-        const std::vector<double> tree = solve<3>(P, how, c, v, {}, e, pb);
+        const std::vector<double> tree = solve<D>(P, how, c, v, mask, e, pb);
         int p2 = 1, log2p2 = 0;
         while (2*p2 <= P) p2 *= 2, ++log2p2;
         int treeLevels = 0;
@@ -275,6 +280,17 @@ TEST_CASE("tree exchange: serial's values, 2 log2(P) messages a rank on a level"
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(tree[i] - ref[i]));
         CHECK(diff <= 1e-12*maxAbs(v));
     }
+}
+
+} // namespace
+
+TEST_CASE("tree exchange: serial's values, 2 log2(P) messages a rank on a level", "[parallel][tree]")
+{
+    const bool surface = GENERATE(true, false);
+    const bool masked = GENERATE(false, true);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    treeEqualsSerial<3>(surface, masked, how, {2, 3, 5, 8, 16});
+    treeEqualsSerial<2>(surface, masked, how, {3, 5});
 }
 
 TEST_CASE("automatic exchange: the tree on the coarse levels that 64 slabs share, chunks or direct below", "[parallel][tree]")
