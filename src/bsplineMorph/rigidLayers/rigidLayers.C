@@ -252,7 +252,7 @@ void Foam::rigidLayers::fitRotations
         }
     }
     // The sums of the ranks that share a point, the same on all of them
-    syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
+    wallSum_->sum(rotation_);
     // Averaged over the neighbouring faces again, nSmooth_ times (a ring of
     // faces each): the rotations vary smoothly over about innerDistance of a
     // deforming wall, so that the rigid offsets under a crease do not cross;
@@ -284,7 +284,7 @@ void Foam::rigidLayers::fitRotations
             }
             rotation_[wi] = sum;
         }
-        syncTools::syncPointList(mesh_, wallPoints_, rotation_, plusEqOp<tensor>(), tensor::zero);
+        wallSum_->sum(rotation_);
         forAll(rotation_, wi)
         {
             rotation_[wi] *= wallPointWeight_[wi];

@@ -145,7 +145,8 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallPointWeight_[wi] = wallPointStart_[wi + 1] - wallPointStart_[wi];
     }
-    syncTools::syncPointList(mesh_, wallPoints_, wallPointWeight_, plusEqOp<scalar>(), scalar(0));
+    wallSum_.reset(new sharedPointSum(mesh_, wallPoints_));
+    wallSum_->sum(wallPointWeight_);
     for (scalar& w : wallPointWeight_)
     {
         w = 1/w;

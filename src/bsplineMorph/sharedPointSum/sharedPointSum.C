@@ -1,0 +1,115 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+\*---------------------------------------------------------------------------*/
+
+#include "sharedPointSum.H"
+#include "globalMeshData.H"
+#include "globalIndex.H"
+#include "coupledPolyPatch.H"
+#include "processorPolyPatch.H"
+#include "processorCyclicPolyPatch.H"
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::sharedPointSum::sharedPointSum
+(
+    const polyMesh& mesh,
+    const labelList& meshPoints
+)
+:
+    mesh_(mesh),
+    meshPoints_(meshPoints),
+    general_(false),
+    toOwner_(Pstream::nProcs()),
+    fromHolder_(Pstream::nProcs())
+{
+    if (!Pstream::parRun())
+    {
+        return;
+    }
+    // Copies related by a transform (mergePoints joins collocated ones only)
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        if
+        (
+            isA<coupledPolyPatch>(pp)
+         && (!isA<processorPolyPatch>(pp) || isA<processorCyclicPolyPatch>(pp))
+        )
+        {
+            general_ = true;
+        }
+    }
+    reduce(general_, orOp<bool>());
+    if (general_)
+    {
+        return;
+    }
+
+    // A global number per shared point, held by its owner
+    Map<label> indexOf(2*meshPoints.size());
+    forAll(meshPoints, i)
+    {
+        indexOf.insert(meshPoints[i], i);
+    }
+    labelList pointToGlobal;
+    labelList uniqueMeshPoints;
+    const autoPtr<globalIndex> numbering =
+        mesh.globalData().mergePoints
+        (
+            meshPoints, indexOf, pointToGlobal, uniqueMeshPoints
+        );
+    List<DynamicList<label>> toOwner(Pstream::nProcs());
+    List<DynamicList<label>> ids(Pstream::nProcs());
+    forAll(meshPoints, i)
+    {
+        const label owner = numbering->whichProcID(pointToGlobal[i]);
+        if (owner != Pstream::myProcNo())
+        {
+            toOwner[owner].append(i);
+            ids[owner].append(pointToGlobal[i]);
+        }
+    }
+    // The owners learn which of their points each holder sends
+    PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
+    forAll(ids, proci)
+    {
+        toOwner_[proci].transfer(toOwner[proci]);
+        if (ids[proci].size())
+        {
+            UOPstream os(proci, buffers);
+            os << labelList(ids[proci]);
+        }
+    }
+    labelList recvSizes;
+    buffers.finishedSends(recvSizes);
+    forAll(recvSizes, proci)
+    {
+        if (recvSizes[proci] > 0)
+        {
+            UIPstream is(proci, buffers);
+            const labelList got(is);
+            labelList& at = fromHolder_[proci];
+            at.setSize(got.size());
+            forAll(got, k)
+            {
+                at[k] = indexOf[uniqueMeshPoints[numbering->toLocal(got[k])]];
+            }
+        }
+    }
+}
+
+
+// ************************************************************************* //
