@@ -115,6 +115,27 @@ Foam::boundaryConstraints::boundaryConstraints
     }
     boundaryPoints_ = onPatch.sortedToc();
 
+    // The points of the patches whose conditions can fix or slide them, on
+    // any rank (a processor boundary can cut such a patch at its edge)
+    labelList onCondition(mesh.nPoints(), 0);
+    for (const pointPatch& pp : pMesh_.boundary())
+    {
+        if (!pp.coupled() && !isA<emptyPointPatch>(pp))
+        {
+            UIndirectList<label>(onCondition, pp.meshPoints()) = 1;
+        }
+    }
+    syncTools::syncPointList(mesh, onCondition, maxEqOp<label>(), label(0));
+    DynamicList<label> conditionPoints;
+    forAll(onCondition, pointi)
+    {
+        if (onCondition[pointi])
+        {
+            conditionPoints.append(pointi);
+        }
+    }
+    conditionPoints_ = std::make_shared<const sharedPoints>(mesh, conditionPoints);
+
     // The points of cyclic couplings, and their copies on other ranks
     // (through processor patches)
     scalarField joined(mesh.nPoints(), 0);
@@ -339,11 +360,11 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     }
     checkPrescribed(nonFinite, emptyDirection);
 
-    // The same view of every processor-shared point on all its ranks
-    const polyMesh& mesh = pMesh_();
-    syncTools::syncPointList(mesh, fixedSync_, maxEqOp<label>(), label(0));
-    syncTools::syncPointList(mesh, value_, maxMagSqrEqOp<vector>(), vector::zero);
-    syncTools::syncPointList(mesh, slide_, combineConstraintsEqOp(), pointConstraint());
+    // The same view of every processor-shared point on all its ranks (the
+    // conditions set values at their patches' points only)
+    conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
+    conditionPoints_->combineMesh(value_, maxMagSqrEqOp<vector>(), vector::zero);
+    conditionPoints_->combineMesh(slide_, combineConstraintsEqOp(), pointConstraint());
 
     for (const label pointi : boundaryPoints_)
     {
@@ -408,6 +429,7 @@ Foam::boundaryConstraints::boundaryConstraints
     fixed_(bc.fixed_),
     value_(bc.value_),
     slide_(bc.slide_),
+    conditionPoints_(bc.conditionPoints_),
     owned_(bc.owned_),
     boundaryPoints_(bc.boundaryPoints_),
     cyclicPoints_(bc.cyclicPoints_),

@@ -145,7 +145,7 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallPointWeight_[wi] = wallPointStart_[wi + 1] - wallPointStart_[wi];
     }
-    wallSum_.reset(new sharedPointSum(mesh_, wallPoints_));
+    wallSum_.reset(new sharedPoints(mesh_, wallPoints_));
     wallSum_->sum(wallPointWeight_);
     for (scalar& w : wallPointWeight_)
     {

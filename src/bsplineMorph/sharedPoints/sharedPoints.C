@@ -15,7 +15,7 @@ License
 
 \*---------------------------------------------------------------------------*/
 
-#include "sharedPointSum.H"
+#include "sharedPoints.H"
 #include "globalMeshData.H"
 #include "globalIndex.H"
 #include "coupledPolyPatch.H"
@@ -24,7 +24,7 @@ License
 
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
-Foam::sharedPointSum::sharedPointSum
+Foam::sharedPoints::sharedPoints
 (
     const polyMesh& mesh,
     const labelList& meshPoints
