@@ -34,6 +34,9 @@ bytes scale with the boundary per rank, (m/n) times as much, the messages and
 rounds stay. Rank counts below the recorded ones take the serial work times
 (n/m)^3 (evaluation) and (n/m)^2 (fit).
 
+--plot PNG: the modelled speed-up and efficiency of the sizes from 8M cells
+on, and a row of what the records measured: the messages and the bytes
+(against the share, with the issue's 2x line) the busiest rank receives.
 --real REAL: key=value lines of real runs (ranks=, solve_s=, fit_s=,
 evaluation_s=: benchmarks/run's multilevelBSpline on the 1M mesh, medians) to
 print beside the model of its smallest recorded size, slabs.
@@ -229,8 +232,30 @@ def main(argv):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         big = sorted({n for n, _, _, _ in cases if n >= 200})
-        fig, axes = plt.subplots(len(big), 2, figsize=(11, 4*len(big)), squeeze=False)
+        fig, axes = plt.subplots(len(big) + 1, 2, figsize=(11, 4*(len(big) + 1)), squeeze=False)
         colours = {"simple": "tab:red", "hierarchical": "tab:blue", "columns": "tab:green"}
+        # what the busiest rank receives per step, as measured (the records)
+        m1, m2 = axes[-1]
+        for (n, decomposition), byRanks in sorted(records.items()):
+            P = sorted(p for p in byRanks if p > 1)
+            style = "-" if n == max(sizes) else "--"
+            label = "%s, %.3gM cells" % (NAMES.get(decomposition, decomposition), n**3/1e6)
+            m1.semilogx(P, [byRanks[p]["messages_max"] for p in P], style, color=colours.get(decomposition),
+                      marker="o", ms=3, label=label)
+            m2.loglog(P, [byRanks[p]["recv_bytes_max"]/byRanks[p]["share_bytes"] for p in P], style,
+                      color=colours.get(decomposition), marker="o", ms=3, label=label)
+        m1.set_title("measured: the busiest rank's messages per step")
+        m2.set_title("measured: the busiest rank's bytes / its boundary share")
+        m1.set_ylabel("messages")
+        m2.set_ylabel("bytes / share")
+        m2.axhline(2, color="k", lw=0.6, ls=":")
+        for a in (m1, m2):
+            a.set_xlabel("ranks")
+            a.set_xticks(ranks[1:])
+            a.set_xticklabels([str(r) for r in ranks[1:]])
+            a.minorticks_off()
+            a.grid(alpha=0.3)
+        m1.legend(fontsize=7, loc="upper left")
         for row, n in zip(axes, big):
             a1, a2 = row
             for m, decomposition, name, rows in cases:
@@ -257,7 +282,8 @@ def main(argv):
                 a.minorticks_off()
                 a.grid(alpha=0.3)
             a2.legend(fontsize=7, loc="lower left")
-        fig.suptitle("Twisted cube, multilevelBSpline's fit, evaluation and exchange per step (benchmarks/scaling)",
+        fig.suptitle("Twisted cube, multilevelBSpline's fit, evaluation and exchange per step (benchmarks/scaling);"
+                     " bottom: the measured exchange (mbaScaling)",
                      fontsize=10)
         fig.tight_layout()
         fig.savefig(plot, dpi=100)
