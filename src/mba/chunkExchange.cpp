@@ -151,7 +151,6 @@ chunkExchange planChunks(const chunkSources<D>& in)
                 maskedRuns(id, n0, nodes, summed, X.fullTo[T.readers[q]]);
         }
     }
-    X.ownTiles = in.ownToView;
     X.partialCounts.assign(offset.begin(), offset.end());
     for (int r = 0; r < in.nRanks; ++r) X.fullCounts.push_back(std::size_t(runValues(X.fullFrom[r], in.nc)));
     return X;

@@ -51,7 +51,6 @@ struct chunkExchange
     std::vector<nodeRun> termRuns;               ///< the terms' node runs
     std::vector<std::vector<nodeRun>> fullTo;    ///< per rank: summed chunks sent to it (round 2)
     std::vector<std::vector<nodeRun>> fullFrom;  ///< per rank: summed chunks it sends here
-    std::vector<std::int64_t> ownTiles;          ///< the own tiles (view ids): all that is cleared per apply
     std::vector<std::size_t> partialCounts;      ///< per rank: values it sends here in round 1
     std::vector<std::size_t> fullCounts;         ///< per rank: values it sends here in round 2
 };

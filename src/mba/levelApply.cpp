@@ -169,9 +169,7 @@ void levelApplier<D>::clearLattice(levelPlan<D>& L) const
     const int blk = levelPlan<D>::npt*ctrl_.nComponents;
     if (L.chunked || L.tree)
     {
-        // the other tiles' nodes are all received (round 2, the tree) or never written
-        for (const std::int64_t id : L.chunked ? L.chunks.ownTiles : L.treeOwn)
-            std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
+        for (const std::int64_t id : L.ownInView) std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
     }
     else if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
     else
@@ -427,7 +425,7 @@ void levelApplier<D>::exchangeInTree(levelPlan<D>& L)
                 v += nc;
             }
     };
-    for (const std::int64_t id : L.treeOwn)
+    for (const std::int64_t id : L.ownInView)
         if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(ph, ph + nc, v); });
     treeSum(comm_, sums, chunkSum_);
     std::fill(L.phi.begin(), L.phi.end(), 0.0);

@@ -477,6 +477,7 @@ void levelPlanner<D>::chooseExchange()
         {
             L_.chunked = true;
             L_.chunks = std::move(X);
+            L_.ownInView = ownToView_;
             dropDirectExchange();
         }
         if (mode_ == params::exchangeMode::chunked) return;
@@ -536,7 +537,7 @@ void levelPlanner<D>::considerTree()
     L_.chunks = chunkExchange();
     dropDirectExchange();
     L_.treeValues = values;
-    L_.treeOwn = ownToView_;
+    L_.ownInView = ownToView_;
     L_.treeStart.assign(L_.view.size(), -1);
     L_.treeNodes.assign(L_.view.size(), 0);
     for (std::int64_t id = 0; id < L_.view.size(); ++id)
@@ -593,14 +594,8 @@ double levelPlanner<D>::currentExchangeCost() const
 template <int D>
 double levelPlanner<D>::treeExchangeCost(std::int64_t n) const
 {
-    std::int64_t messages = 0, values = 0;
-    const std::vector<treeRound> rounds = treeRounds(nRanks_, me_, std::size_t(n));
-    for (const treeRound& r : rounds)
-    {
-        messages += r.recvEnd > r.recvBegin;
-        values += std::int64_t(r.recvEnd - r.recvBegin);
-    }
-    return exchangeCost(int(rounds.size()), messages, values*std::int64_t(sizeof(double)));
+    const treeTraffic t = treeTrafficOf(nRanks_, me_, std::size_t(n));
+    return exchangeCost(t.rounds, t.messagesReceived, t.valuesReceived*std::int64_t(sizeof(double)));
 }
 
 template <int D>
@@ -623,14 +618,13 @@ void levelPlanner<D>::fillStats()
         + L.scaledResiduals.capacity()*sizeof(double));
     if (L.tree)
     {
-        for (const treeRound& r : treeRounds(nRanks_, me_, std::size_t(L.treeValues)))
-        {
-            s.messagesSent += r.sendEnd > r.sendBegin;
-            s.messagesReceived += r.recvEnd > r.recvBegin;
-            s.bytesSentPerApply += std::int64_t((r.sendEnd - r.sendBegin)*sizeof(double));
-            s.bytesReceivedPerApply += std::int64_t((r.recvEnd - r.recvBegin)*sizeof(double));
-        }
-        s.bytes += std::int64_t((L.treeStart.capacity() + L.treeOwn.capacity() + L.treeNodes.capacity())*8);
+        const treeTraffic t = treeTrafficOf(nRanks_, me_, std::size_t(L.treeValues));
+        s.messagesSent += t.messagesSent;
+        s.messagesReceived += t.messagesReceived;
+        s.bytesSentPerApply += t.valuesSent*std::int64_t(sizeof(double));
+        s.bytesReceivedPerApply += t.valuesReceived*std::int64_t(sizeof(double));
+        s.bytes += std::int64_t((L.treeStart.capacity() + L.ownInView.capacity())*sizeof(std::int64_t)
+            + L.treeNodes.capacity()*sizeof(std::uint64_t));
         return;
     }
     if (L.chunked)

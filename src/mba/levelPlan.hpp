@@ -89,6 +89,10 @@ struct levelPlan
     bool chunked = false;           ///< the partial sums meet in chunks (chunks), not directly
     chunkExchange chunks;
 
+    /// Chunked or tree: the own tiles (view ids), all that an apply clears
+    /// (the other tiles' nodes are received whole or never written)
+    std::vector<std::int64_t> ownInView;
+
     /// The partial sums meet in a tree of all ranks (treeSum): the values at
     /// the nodes where omega > 0 of the level's tiles of every rank, in key
     /// order, nodes in order
@@ -96,7 +100,6 @@ struct levelPlan
     std::int64_t treeValues = 0;            ///< tree: values summed
     std::vector<std::int64_t> treeStart;    ///< tree: per view tile, where its values start (-1: none)
     std::vector<std::uint64_t> treeNodes;   ///< tree: per view tile, its nodes among them (bit n: node n)
-    std::vector<std::int64_t> treeOwn;      ///< tree: the own tiles (view ids)
 
     levelStats stats;
 

@@ -66,6 +66,20 @@ std::vector<treeRound> treeRounds(int P, int me, std::size_t n)
     return rounds;
 }
 
+treeTraffic treeTrafficOf(int P, int me, std::size_t n)
+{
+    treeTraffic t;
+    for (const treeRound& r : treeRounds(P, me, n))
+    {
+        ++t.rounds;
+        t.messagesSent += r.sendEnd > r.sendBegin;
+        t.messagesReceived += r.recvEnd > r.recvBegin;
+        t.valuesSent += std::int64_t(r.sendEnd - r.sendBegin);
+        t.valuesReceived += std::int64_t(r.recvEnd - r.recvBegin);
+    }
+    return t;
+}
+
 void treeSum(const communicator& comm, std::vector<double>& v, std::vector<double>& work)
 {
     for (const treeRound& r : treeRounds(comm.size(), comm.rank(), v.size()))

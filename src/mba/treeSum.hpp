@@ -30,6 +30,15 @@ struct treeRound
 /// them: every rank has as many (empty ones where it waits)
 std::vector<treeRound> treeRounds(int P, int me, std::size_t n);
 
+/// What rank me sends and receives in the rounds of the sum of n values
+/// over P ranks (messages: the non-empty ones)
+struct treeTraffic
+{
+    int rounds = 0;
+    std::int64_t messagesSent = 0, messagesReceived = 0, valuesSent = 0, valuesReceived = 0;
+};
+treeTraffic treeTrafficOf(int P, int me, std::size_t n);
+
 /// v (the same size on every rank) summed over the ranks, in place, through
 /// treeRounds (communicator::sendReceive); work is kept by the caller. Collective.
 void treeSum(const communicator& comm, std::vector<double>& v, std::vector<double>& work);
