@@ -32,6 +32,29 @@ License
 
 #include <cmath>
 
+// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
+
+namespace
+{
+    //- The points flagged (non-zero) on any rank that holds them, ascending
+    //  (flag is synced in place)
+    Foam::labelList onAnyRank(const Foam::polyMesh& mesh, Foam::labelList& flag)
+    {
+        using namespace Foam;
+        syncTools::syncPointList(mesh, flag, maxEqOp<label>(), label(0));
+        DynamicList<label> points;
+        forAll(flag, pointi)
+        {
+            if (flag[pointi])
+            {
+                points.append(pointi);
+            }
+        }
+        return labelList(std::move(points));
+    }
+}
+
+
 // * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
 bool Foam::boundaryConstraints::axisMask(const pointConstraint& pc, bool mask[3])
@@ -105,40 +128,29 @@ Foam::boundaryConstraints::boundaryConstraints
         owned_[coupledPoints[i]] = owner[i] == Pstream::myProcNo();
     }
 
+    // The points of every patch but empty ones, and of those whose
+    // conditions can fix or slide them (not coupled) on any rank: a
+    // processor boundary can cut such a patch at its edge
     bitSet onPatch(mesh.nPoints());
+    labelList onCondition(mesh.nPoints(), 0);
     for (const pointPatch& pp : pMesh_.boundary())
     {
         if (!isA<emptyPointPatch>(pp))
         {
             onPatch.set(pp.meshPoints());
+            if (!pp.coupled())
+            {
+                UIndirectList<label>(onCondition, pp.meshPoints()) = 1;
+            }
         }
     }
     boundaryPoints_ = onPatch.sortedToc();
-
-    // The points of the patches whose conditions can fix or slide them, on
-    // any rank (a processor boundary can cut such a patch at its edge)
-    labelList onCondition(mesh.nPoints(), 0);
-    for (const pointPatch& pp : pMesh_.boundary())
-    {
-        if (!pp.coupled() && !isA<emptyPointPatch>(pp))
-        {
-            UIndirectList<label>(onCondition, pp.meshPoints()) = 1;
-        }
-    }
-    syncTools::syncPointList(mesh, onCondition, maxEqOp<label>(), label(0));
-    DynamicList<label> conditionPoints;
-    forAll(onCondition, pointi)
-    {
-        if (onCondition[pointi])
-        {
-            conditionPoints.append(pointi);
-        }
-    }
-    conditionPoints_ = std::make_shared<const sharedPoints>(mesh, conditionPoints);
+    conditionPoints_ =
+        std::make_shared<const sharedPoints>(mesh, onAnyRank(mesh, onCondition));
 
     // The points of cyclic couplings, and their copies on other ranks
     // (through processor patches)
-    scalarField joined(mesh.nPoints(), 0);
+    labelList joined(mesh.nPoints(), 0);
     for (const polyPatch& pp : mesh.boundaryMesh())
     {
         const bool cyclicCoupling =
@@ -146,19 +158,10 @@ Foam::boundaryConstraints::boundaryConstraints
          || (isA<cyclicPolyPatch>(pp) && !isA<processorPolyPatch>(pp));
         if (cyclicCoupling)
         {
-            for (const label pointi : pp.meshPoints())
-            {
-                joined[pointi] = 1;
-            }
+            UIndirectList<label>(joined, pp.meshPoints()) = 1;
         }
     }
-    syncTools::syncPointList(mesh, joined, maxEqOp<scalar>(), scalar(0));
-    DynamicList<label> cyclic;
-    forAll(joined, pointi)
-    {
-        if (joined[pointi] > 0) cyclic.append(pointi);
-    }
-    cyclicPoints_.transfer(cyclic);
+    cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
 
     update(pointDisplacement);
