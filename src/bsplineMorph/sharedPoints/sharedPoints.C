@@ -17,6 +17,7 @@ License
 
 #include "sharedPoints.H"
 #include "globalMeshData.H"
+#include "PstreamBuffers.H"
 #include "globalIndex.H"
 #include "coupledPolyPatch.H"
 #include "processorPolyPatch.H"
