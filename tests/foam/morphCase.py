@@ -24,6 +24,8 @@ ap.add_argument("--coeff", nargs=2, action="append", default=[], metavar=("KEYWO
                 help="an entry of the solver's coefficients (repeatable)")
 ap.add_argument("--end", type=int, default=3)
 ap.add_argument("--merge-sides", action="store_true", help="one slip patch for the four x/y faces")
+ap.add_argument("--free-sides", action="store_true",
+                help="the x/y faces take the interpolated displacement (calculated) instead of slipping")
 ap.add_argument("--move", type=float, default=0.06, help="x displacement of the hole at t=3")
 ap.add_argument("--rotate", type=float, default=None, metavar="DEG",
                 help="turn the hole rigidly about the z axis through (0.45 0.5 0.5) by DEG at the end time instead")
@@ -141,6 +143,9 @@ if a.rotate is not None:
     bc["hole"] = ("type solidBodyMotionDisplacement; solidBodyMotionFunction rotatingMotion; "
                   "rotatingMotionCoeffs { solidBodyMotionFunction rotatingMotion; origin (0.45 0.5 0.5); "
                   "axis (0 0 1); omega %.17g; } value uniform (0 0 0);" % (a.rotate*3.141592653589793/180/a.end))
+if a.free_sides:
+    for k in ["xMin", "xMax", "yMin", "yMax", "sides"]:
+        bc[k] = "type calculated; value uniform (0 0 0);"
 if a.twoD:
     bc["xMin"] = bc["xMax"] = "type fixedValue; value uniform (0 0 0);"
 body = "dimensions [0 1 0 0 0 0 0];\ninternalField uniform (0 0 0);\nboundaryField {\n"

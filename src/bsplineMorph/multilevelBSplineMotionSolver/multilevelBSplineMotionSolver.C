@@ -22,6 +22,8 @@ License
 #include "Enum.H"
 #include "clockTime.H"
 
+#include <cstdio>
+
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
 namespace Foam
@@ -320,11 +322,36 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
             << "Cannot set up the multilevel B-spline plan: " << e.what()
             << exit(FatalError);
     }
+    const label nControl = bc.nControlGlobal();
     Info<< type() << ": " << (refit ? "re-fit " : "") << "plan for "
-        << bc.nControlGlobal() << " control points, "
+        << nControl << " control points, "
         << returnReduce(points0().size(), sumOp<label>()) << " mesh points ("
-        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D"
-        << endl;
+        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D";
+    if (Pstream::parRun())
+    {
+        // The fit's work is per control point: how evenly the ranks hold them
+        const label most =
+            returnReduce(bc.controlPoints().size(), maxOp<label>());
+        const scalar imbalance =
+            scalar(most)*Pstream::nProcs()/max(scalar(nControl), scalar(1));
+        char ratio[32];
+        std::snprintf(ratio, sizeof(ratio), "%.2f", imbalance);
+        Info<< "; at most " << most << " on a rank (" << ratio
+            << " times the mean)" << endl;
+        if (!refit && imbalance >= 1.5)
+        {
+            Info<< type() << ": the fit's work follows the control points,"
+                << " and the busiest rank holds " << ratio << " times the"
+                << " mean: a decomposition that gives every rank a share of"
+                << " the patches that fix or prescribe the displacement"
+                << " balances it (a box's top and bottom: columns,"
+                << " hierarchical with n (a b 1))" << endl;
+        }
+    }
+    else
+    {
+        Info<< endl;
+    }
     return interpolator;
 }
 
