@@ -222,6 +222,31 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
         CHECK(r.where.max().x() < 0.3 + 1.2*0.5 + 0.3 + 1e-9);
     }
 
+    SECTION("a layer of cells flattened to no volume: reported where it is")
+    {
+        // The points at x = 0.5 moved onto x = 0.4 (to round-off): the
+        // volume-weighted centres of those cells, divided by volumes near
+        // zero, lie anywhere; the report gives the means of their points
+        pointField p(p0);
+        forAll(p, pointi)
+        {
+            if (mag(p0[pointi].x() - 0.5) < 1e-9)
+            {
+                p[pointi].x() = 0.4 + 1e-15*p0[pointi].y()*(1 - p0[pointi].z());
+            }
+        }
+        const invertedCellCheck::result r = check.check(p);
+        // (of the flattened layer's 48 cells, those whose round-off volume
+        // or pyramids checkMesh calls an error)
+        CHECK(r.nInvalid > 0);
+        CHECK(r.nInvalid <= bsmTest::caseCells[1]*bsmTest::caseCells[2]);
+        CHECK(r.nInvalid == checkMeshInvalidCells(mesh, p));
+        CHECK(mag(r.where.min().x() - 0.4) < 1e-9);
+        CHECK(mag(r.where.max().x() - 0.4) < 1e-9);
+        CHECK(r.where.min().y() > 0);
+        CHECK(r.where.max().y() < 1);
+    }
+
     SECTION("one point pushed into its neighbours: folded cells of positive volume")
     {
         // The mesh point at (0.3, 0.5, 0.5) pushed along (1, 1, 1) by a

@@ -89,7 +89,7 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
         << " (" << r.nNonPositive << " of non-positive volume, "
         << r.nFolded << " folded: positive volume but a face pyramid"
         << " wrongly oriented against the cell centre, as checkMesh counts"
-        << " them; cell centres within " << r.where << ")";
+        << " them; cells (their points' means) within " << r.where << ")";
     if (invertedCellsFatal_)
     {
         FatalErrorInFunction

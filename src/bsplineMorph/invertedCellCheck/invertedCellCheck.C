@@ -512,7 +512,16 @@ Foam::invertedCellCheck::check(const pointField& points) const
         {
             ++r.nInvalid;
             (verdict == 1 ? r.nNonPositive : r.nFolded) += 1;
-            r.where.add(centre);
+            // Where: the mean of the cell's points (the volume-weighted
+            // centre of a cell whose volume is near zero lies anywhere)
+            const labelList cellPoints =
+                mesh_.cells()[celli].labels(mesh_.faces());
+            point mean = Zero;
+            for (const label pointi : cellPoints)
+            {
+                mean += points[pointi];
+            }
+            r.where.add(mean/cellPoints.size());
         }
     }
     reduce(r.nInvalid, sumOp<label>());
