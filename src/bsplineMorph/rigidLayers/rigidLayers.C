@@ -170,8 +170,18 @@ Foam::scalar Foam::rigidLayers::weight
     {
         return 0;
     }
-    const scalar t = (outer - d)/(outer - inner);
-    return t*t*t*(t*(6*t - 15) + 10);
+    // (1 - s)^4 (1 + 4 s) of s = (d - inner)/(outer - inner): slope zero at
+    // both ends (C1). The blend adds to the interpolated field w times the
+    // gap between it and the rigid motion, which grows from zero at the
+    // zone's outermost points about as s does: its strain along the normal
+    // is d(s w)/ds times the two fields' difference in strain. That turns
+    // from 1 at inner to at least -0.44 before outer (the quintic smoothstep:
+    // -0.78), so this weight, falling fast where the gap is still small,
+    // strains the blend the least of the weights tried (BENCHMARKS.md,
+    // "rigidLayers cost")
+    const scalar s = (d - inner)/(outer - inner);
+    const scalar r = 1 - s;
+    return r*r*r*r*(1 + 4*s);
 }
 
 
