@@ -176,9 +176,9 @@ Foam::scalar Foam::rigidLayers::weight
     // zone's outermost points about as s does: its strain along the normal
     // is d(s w)/ds times the two fields' difference in strain. That turns
     // from 1 at inner to at least -0.44 before outer (the quintic smoothstep:
-    // -0.78), so this weight, falling fast where the gap is still small,
-    // strains the blend the least of the weights tried (BENCHMARKS.md,
-    // "rigidLayers cost")
+    // -0.78): this weight falls fast while the gap is still small (steeper
+    // ones of the same family, (1 - s)^k (1 + k s), undershoot less but
+    // blend over less of the band; BENCHMARKS.md, "rigidLayers cost")
     const scalar s = (d - inner)/(outer - inner);
     const scalar r = 1 - s;
     return r*r*r*r*(1 + 4*s);
