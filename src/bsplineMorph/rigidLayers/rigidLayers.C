@@ -170,18 +170,21 @@ Foam::scalar Foam::rigidLayers::weight
     {
         return 0;
     }
-    // (1 - s)^4 (1 + 4 s) of s = (d - inner)/(outer - inner): slope zero at
+    // (1 - s)^6 (1 + 6 s) of s = (d - inner)/(outer - inner): slope zero at
     // both ends (C1). The blend adds to the interpolated field w times the
     // gap between it and the rigid motion, which grows from zero at the
     // zone's outermost points about as s does: its strain along the normal
     // is d(s w)/ds times the two fields' difference in strain. That turns
-    // from 1 at inner to at least -0.44 before outer (the quintic smoothstep:
-    // -0.78): this weight falls fast while the gap is still small (steeper
-    // ones of the same family, (1 - s)^k (1 + k s), undershoot less but
-    // blend over less of the band; BENCHMARKS.md, "rigidLayers cost")
+    // from 1 at inner to at least -0.37 before outer (the quintic smoothstep:
+    // -0.78): this weight falls fast while the gap is still small. Of the
+    // family (1 - s)^k (1 + k s), k = 6 kept every cell of the twisted cube
+    // at amplitude 1.5 from 50^3 to 100^3 cells, where k = 4 and the quintic
+    // folded some, and turns a body in a far field as well as the quintic
+    // (BENCHMARKS.md, "rigidLayers cost")
     const scalar s = (d - inner)/(outer - inner);
     const scalar r = 1 - s;
-    return r*r*r*r*(1 + 4*s);
+    const scalar r2 = r*r;
+    return r2*r2*r2*(1 + 6*s);
 }
 
 
