@@ -17,7 +17,6 @@ License
 
 #include "sharedPoints.H"
 #include "globalMeshData.H"
-#include "PstreamBuffers.H"
 #include "globalIndex.H"
 #include "coupledPolyPatch.H"
 #include "processorPolyPatch.H"
@@ -83,31 +82,22 @@ Foam::sharedPoints::sharedPoints
             ids[owner].append(pointToGlobal[i]);
         }
     }
-    // The owners learn which of their points each holder sends
-    PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
+    // The owners learn which of their points each holder sends (sizes
+    // they do not know yet: the communicator's exchange of arrays)
+    std::vector<std::vector<label>> send(Pstream::nProcs());
     forAll(ids, proci)
     {
         toOwner_[proci].transfer(toOwner[proci]);
-        if (ids[proci].size())
-        {
-            UOPstream os(proci, buffers);
-            os << labelList(ids[proci]);
-        }
+        send[proci].assign(ids[proci].begin(), ids[proci].end());
     }
-    labelList recvSizes;
-    buffers.finishedSends(recvSizes);
-    forAll(recvSizes, proci)
+    const std::vector<std::vector<label>> got = comm_.exchange(send);
+    forAll(fromHolder_, proci)
     {
-        if (recvSizes[proci] > 0)
+        labelList& at = fromHolder_[proci];
+        at.setSize(got[proci].size());
+        forAll(at, k)
         {
-            UIPstream is(proci, buffers);
-            const labelList got(is);
-            labelList& at = fromHolder_[proci];
-            at.setSize(got.size());
-            forAll(got, k)
-            {
-                at[k] = indexOf[uniqueMeshPoints[numbering->toLocal(got[k])]];
-            }
+            at[k] = indexOf[uniqueMeshPoints[numbering->toLocal(got[proci][k])]];
         }
     }
 }
