@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <random>
 
 using namespace Foam;
 
@@ -453,4 +454,101 @@ TEST_CASE("rigidLayers: the fitted rotation is the rotation of a rigid map", "[f
     // A mirror or a singular map has no rotation: identity
     CHECK(rigidLayers::rotation(tensor(-1, 0, 0, 0, 1, 0, 0, 0, 1)) == tensor::I);
     CHECK(rigidLayers::rotation(tensor::zero) == tensor::I);
+}
+
+
+TEST_CASE("rigidLayers: the rotations' smoothing takes n averagings in about 5 sqrt(n) sweeps", "[foam][rigidLayers]")
+{
+    // The coefficients: ((1 + x)/2)^n to 1e-12 on [-1, 1], fewer than n
+    // terms from n = 21 on, summing to 1 (constants kept)
+    for (const label n : {1, 20, 21, 37, 145, 400})
+    {
+        const scalarList a = rigidLayers::powerCoeffs(n, 1e-12);
+        scalar sum = 0, worst = 0;
+        for (const scalar ak : a)
+        {
+            sum += ak;
+        }
+        for (label i = 0; i <= 200; ++i)
+        {
+            const scalar x = -1 + i/100.0;
+            scalar p = 0;
+            forAll(a, k)
+            {
+                p += a[k]*std::cos(k*std::acos(x));
+            }
+            worst = max(worst, std::abs(p - std::pow((1 + x)/2, n)));
+        }
+        INFO("n = " << n << ": " << a.size() - 1 << " sweeps");
+        CHECK(std::abs(sum - 1) < 1e-15);
+        CHECK(worst < 2e-12);
+        CHECK(a.size() - 1 <= (n < 21 ? n : label(std::ceil(5.1*std::sqrt(scalar(n))))));
+        CHECK((n < 21 || a.size() - 1 < n));
+    }
+    CHECK(rigidLayers::powerCoeffs(145, 1e-12).size() - 1 == 60);
+
+    // The averaging of a wall: each face's mean of its points, then each
+    // point's mean of its faces; here a chain of edges with a triangle at
+    // every third point, and seeded random tensors
+    const label nPoints = 300;
+    std::vector<std::vector<label>> faces;
+    for (label i = 0; i + 1 < nPoints; ++i)
+    {
+        faces.push_back({i, i + 1});
+        if (i % 3 == 0 && i + 2 < nPoints)
+        {
+            faces.push_back({i, i + 1, i + 2});
+        }
+    }
+    label nSweeps = 0;
+    const rigidLayers::sweepFunction sweep = [&](const tensorField& in, tensorField& out)
+    {
+        ++nSweeps;
+        tensorField sum(nPoints, Zero);
+        scalarField count(nPoints, Zero);
+        for (const auto& f : faces)
+        {
+            tensor mean(Zero);
+            for (const label p : f)
+            {
+                mean += in[p]/scalar(f.size());
+            }
+            for (const label p : f)
+            {
+                sum[p] += mean;
+                count[p] += 1;
+            }
+        }
+        out.setSize(nPoints);
+        forAll(out, p)
+        {
+            out[p] = sum[p]/count[p];
+        }
+    };
+    std::mt19937 random(2026);
+    std::uniform_real_distribution<scalar> uniform(-1, 1);
+    tensorField v0(nPoints);
+    for (tensor& t : v0)
+    {
+        for (direction c = 0; c < tensor::nComponents; ++c)
+        {
+            t[c] = uniform(random);
+        }
+    }
+    for (const label n : {10, 37, 145})
+    {
+        tensorField plain(v0), fast(v0);
+        List<tensorField> work;
+        nSweeps = 0;
+        rigidLayers::power(plain, n, scalarList(), sweep, work);
+        CHECK(nSweeps == n);
+        const scalarList a = rigidLayers::powerCoeffs(n, 1e-12);
+        nSweeps = 0;
+        rigidLayers::power(fast, n, a, sweep, work);
+        INFO("n = " << n << ": " << nSweeps << " sweeps");
+        CHECK(nSweeps == min(n, label(a.size() - 1)));
+        // The same smoothing (which changes the field by far more)
+        CHECK(max(mag(fast - plain)) < 1e-12);
+        CHECK(max(mag(plain - v0)) > 0.5);
+    }
 }

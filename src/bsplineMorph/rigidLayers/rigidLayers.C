@@ -61,6 +61,7 @@ namespace
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
 const Foam::label Foam::rigidLayers::maxSmooth;
+const Foam::scalar Foam::rigidLayers::powerTolerance = 1e-12;
 
 
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
@@ -219,6 +220,89 @@ Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
 }
 
 
+Foam::scalarList Foam::rigidLayers::powerCoeffs(const label n, const scalar tol)
+{
+    // With x = cos(t): ((1 + x)/2)^n = cos(t/2)^(2n)
+    // = 4^-n (C(2n, n) + 2 sum_k C(2n, n - k) cos(k t)), and cos(k t) = T_k(x):
+    // b_k = C(2n, n - k)/4^n, a binomial distribution over k = -n .. n
+    scalarList b(n + 1);
+    b[0] = std::exp(std::lgamma(2.0*n + 1) - 2*std::lgamma(n + 1.0) - n*std::log(4.0));
+    for (label k = 1; k <= n; ++k)
+    {
+        b[k] = b[k - 1]*scalar(n - k + 1)/scalar(n + k);
+    }
+    // The weight of the terms above m, summed from the smallest
+    scalarList above(n + 2, Zero);
+    for (label k = n; k >= 0; --k)
+    {
+        above[k] = above[k + 1] + 2*b[k];
+    }
+    label m = 0;
+    while (m < n && above[m + 1] > tol)
+    {
+        ++m;
+    }
+    scalarList a(m + 1);
+    scalar sum = 0;
+    for (label k = 0; k <= m; ++k)
+    {
+        a[k] = k ? 2*b[k] : b[0];
+        sum += a[k];
+    }
+    for (scalar& ak : a)
+    {
+        ak /= sum;
+    }
+    return a;
+}
+
+
+void Foam::rigidLayers::power
+(
+    tensorField& v,
+    const label n,
+    const scalarList& coeffs,
+    const sweepFunction& sweep,
+    List<tensorField>& work
+)
+{
+    const label m = coeffs.size() - 1;
+    if (m < 1 || m >= n)
+    {
+        for (label sweepi = 0; sweepi < n; ++sweepi)
+        {
+            sweep(v, v);
+        }
+        return;
+    }
+    // T_0 = v, T_1 = (2A - I) v, T_k+1 = 2 (2A - I) T_k - T_k-1: bounded by
+    // v, since 2A - I has its eigenvalues in [-1, 1]; v <- sum a_k T_k
+    work.setSize(3);
+    tensorField& prev = work[0];
+    tensorField& cur = work[1];
+    tensorField& next = work[2];
+    prev = v;
+    sweep(prev, cur);
+    forAll(v, i)
+    {
+        cur[i] = 2*cur[i] - prev[i];
+        v[i] = coeffs[0]*prev[i] + coeffs[1]*cur[i];
+    }
+    for (label k = 2; k <= m; ++k)
+    {
+        sweep(cur, next);
+        const scalar ak = coeffs[k];
+        forAll(v, i)
+        {
+            next[i] = 4*next[i] - 2*cur[i] - prev[i];
+            v[i] += ak*next[i];
+        }
+        prev.swap(cur);
+        cur.swap(next);
+    }
+}
+
+
 void Foam::rigidLayers::fitRotations
 (
     const pointField& points0,
@@ -275,7 +359,7 @@ void Foam::rigidLayers::fitRotations
     // then divided; means, so that hundreds of sweeps do not overflow)
     const label nWallFaces = wallFaceStart_.size() - 1;
     faceMeans_.setSize(nWallFaces);
-    for (label sweep = 0; sweep < nSmooth_; ++sweep)
+    const sweepFunction sweep = [&](const tensorField& in, tensorField& out)
     {
         for (label facei = 0; facei < nWallFaces; ++facei)
         {
@@ -284,10 +368,11 @@ void Foam::rigidLayers::fitRotations
             tensor sum(Zero);
             for (label i = start; i < end; ++i)
             {
-                sum += rotation_[wallFacePoints_[i]];
+                sum += in[wallFacePoints_[i]];
             }
             faceMeans_[facei] = sum/scalar(end - start);
         }
+        out.setSize(nWall);
         for (label wi = 0; wi < nWall; ++wi)
         {
             tensor sum(Zero);
@@ -295,14 +380,15 @@ void Foam::rigidLayers::fitRotations
             {
                 sum += faceMeans_[wallPointFaces_[i]];
             }
-            rotation_[wi] = sum;
+            out[wi] = sum;
         }
-        wallSum_->sum(rotation_);
-        forAll(rotation_, wi)
+        wallSum_->sum(out);
+        forAll(out, wi)
         {
-            rotation_[wi] *= wallPointWeight_[wi];
+            out[wi] *= wallPointWeight_[wi];
         }
-    }
+    };
+    power(rotation_, nSmooth_, smoothCoeffs_, sweep, smoothWork_);
     for (tensor& R : rotation_)
     {
         R = rotation(R);

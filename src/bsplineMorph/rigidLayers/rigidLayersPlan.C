@@ -95,10 +95,12 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallOf.insert(wallPoints_[i], i);
     }
-    // The smoothing of the rotations: a sweep (each point gets the sums of
-    // its faces' points) spreads them by a variance of about half an edge
-    // squared, so (innerDistance/edge)^2 sweeps, by the walls' mean edge,
-    // smooth them over a standard deviation of about innerDistance/sqrt(2)
+    // The smoothing of the rotations: an averaging (each point gets the
+    // means of its faces' points) spreads them by a variance of about half an
+    // edge squared, so (innerDistance/edge)^2 of them, by the walls' mean
+    // edge, smooth them over a standard deviation of about
+    // innerDistance/sqrt(2); summed from Chebyshev polynomials of the
+    // averaging they take about 5 innerDistance/edge sweeps (powerCoeffs)
     scalar edgeSum = 0;
     label nEdges = 0;
     for (const label patchi : patchIDs_)
@@ -113,6 +115,11 @@ void Foam::rigidLayers::findWallPoints()
     nEdges = returnReduce(nEdges, sumOp<label>());
     const scalar rings = nEdges && edgeSum > 0 ? innerDistance_*nEdges/edgeSum : 0;
     nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
+    smoothCoeffs_ = powerCoeffs(nSmooth_, powerTolerance);
+    if (smoothCoeffs_.size() > nSmooth_)
+    {
+        smoothCoeffs_.clear();
+    }
 
     // Each listed face's points as indices into wallPoints_
     DynamicList<label> start(1, 0);
@@ -362,7 +369,9 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << " within innerDistance " << innerDistance_ << ", "
         << returnReduce(shellPoints_.size(), sumOp<label>())
         << " of them outermost: control points; rotations smoothed over "
-        << nSmooth_ << " rings of faces)" << endl;
+        << nSmooth_ << " rings of faces, in "
+        << (smoothCoeffs_.size() ? smoothCoeffs_.size() - 1 : nSmooth_)
+        << " sweeps)" << endl;
 }
 
 
