@@ -246,6 +246,12 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
         CHECK(mag(r.where.max().x() - 0.4) < 1e-9);
         CHECK(r.where.min().y() > 0);
         CHECK(r.where.max().y() < 1);
+        // This rank's invalid cells: those of the flattened layer
+        CHECK(returnReduce(r.cells.size(), sumOp<label>()) == r.nInvalid);
+        for (const label celli : r.cells)
+        {
+            CHECK(mag(mesh.cellCentres()[celli].x() - 0.45) < 0.051);
+        }
     }
 
     SECTION("one point pushed into its neighbours: folded cells of positive volume")

@@ -90,6 +90,15 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
         << r.nFolded << " folded: positive volume but a face pyramid"
         << " wrongly oriented against the cell centre, as checkMesh counts"
         << " them; cells (their points' means) within " << r.where << ")";
+    const label nBlend = rigidLayersPtr_ ? rigidLayersPtr_->nCellsInBlend(r.cells) : 0;
+    if (nBlend)
+    {
+        what<< "; " << nBlend << " of them have a point in the rigidLayers"
+            << " blend (between innerDistance and outerDistance), which"
+            << " strains most under a crease of a deforming wall: a"
+            << " narrower blend (outerDistance nearer innerDistance)"
+            << " strains it less";
+    }
     if (invertedCellsFatal_)
     {
         FatalErrorInFunction

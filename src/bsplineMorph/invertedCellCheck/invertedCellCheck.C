@@ -503,6 +503,7 @@ Foam::invertedCellCheck::check(const pointField& points) const
 
     result r;
     r.where = boundBox::invertedBox;
+    DynamicList<label> invalid;
     for (const label celli : candidates)
     {
         ++r.nJudged;
@@ -511,6 +512,7 @@ Foam::invertedCellCheck::check(const pointField& points) const
         if (verdict)
         {
             ++r.nInvalid;
+            invalid.append(celli);
             (verdict == 1 ? r.nNonPositive : r.nFolded) += 1;
             // Where: the mean of the cell's points (the volume-weighted
             // centre of a cell whose volume is near zero lies anywhere)
@@ -524,6 +526,7 @@ Foam::invertedCellCheck::check(const pointField& points) const
             r.where.add(mean/cellPoints.size());
         }
     }
+    r.cells.transfer(invalid);
     reduce(r.nInvalid, sumOp<label>());
     reduce(r.nNonPositive, sumOp<label>());
     reduce(r.nFolded, sumOp<label>());

@@ -548,6 +548,30 @@ void Foam::rigidLayers::markRigid(bitSet& rigid) const
 }
 
 
+Foam::label Foam::rigidLayers::nCellsInBlend(const labelList& cells) const
+{
+    bitSet blend(mesh_.nPoints());
+    forAll(zonePoints_, i)
+    {
+        if (zoneWeight_[i] < 1)
+        {
+            blend.set(zonePoints_[i]);
+        }
+    }
+    label n = 0;
+    for (const label celli : cells)
+    {
+        const labelList cellPoints = mesh_.cells()[celli].labels(mesh_.faces());
+        n += std::any_of
+        (
+            cellPoints.begin(), cellPoints.end(),
+            [&](const label pointi) { return blend.test(pointi); }
+        );
+    }
+    return returnReduce(n, sumOp<label>());
+}
+
+
 Foam::label Foam::rigidLayers::nZonePointsGlobal() const
 {
     return returnReduce(zonePoints_.size(), sumOp<label>());
