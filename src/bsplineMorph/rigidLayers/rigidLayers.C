@@ -319,10 +319,11 @@ void Foam::rigidLayers::fitRotations
     const label nWall = wallPoints_.size();
     rotation_.setSize(nWall);
     rotation_ = Zero;
+    tensorField patchSum(patchIDs_.size(), Zero);
     label wallFacei = 0;
-    for (const label patchi : patchIDs_)
+    forAll(patchIDs_, k)
     {
-        for (const face& f : pbm[patchi])
+        for (const face& f : pbm[patchIDs_[k]])
         {
             const label start = wallFaceStart_[wallFacei];
             const label end = wallFaceStart_[++wallFacei];
@@ -346,7 +347,16 @@ void Foam::rigidLayers::fitRotations
             {
                 rotation_[wallFacePoints_[i]] += M;
             }
+            patchSum[k] += M;
         }
+    }
+    // Each patch's rotation as a whole (its faces on all ranks)
+    Pstream::listCombineGather(patchSum, plusEqOp<tensor>());
+    Pstream::listCombineScatter(patchSum);
+    patchRotation_.setSize(patchIDs_.size());
+    forAll(patchSum, k)
+    {
+        patchRotation_[k] = rotation(patchSum[k]);
     }
     // The sums of the ranks that share a point, the same on all of them
     wallSum_->sum(rotation_);
@@ -520,12 +530,23 @@ void Foam::rigidLayers::apply
         }
         const label j = zoneFoot_[i];
         const vector& arm = zoneArm_[i];
-        vector rigid = footDisplacement_[j] + (rotation_[j] & arm) - arm;
         const scalar w = zoneWeight_[i];
         vector& d = displacement[pointi];
+        vector rigid;
         if (w < 1)
         {
+            // In the blend the wall's rotation as a whole (its patch's)
+            // carries on along the arm; the foot's own turn against it acts
+            // on the arm up to innerDistance only, so that the local turns
+            // of a deforming wall (under a crease) do not fan out further
+            const tensor& Rp = patchRotation_[footPatch_[j]];
+            const vector inner = arm*(innerDistance_/max(mag(arm), innerDistance_));
+            rigid = footDisplacement_[j] + (Rp & arm) - arm + ((rotation_[j] - Rp) & inner);
             rigid = d + w*(rigid - d);
+        }
+        else
+        {
+            rigid = footDisplacement_[j] + (rotation_[j] & arm) - arm;
         }
         for (direction c = 0; c < 3; ++c)
         {
