@@ -37,8 +37,8 @@ namespace
         return mba::bytes(l.begin(), l.end());
     }
 
-    //- The tag of the point-to-point messages whose sizes both sides know
-    //  (exchangeInPlace, sendReceiveBytes): none of OpenFOAM's
+    //- The tag of the tree sum's rounds (sendReceiveBytes): none of
+    //  OpenFOAM's
     const int pointToPointTag = 28002;
 
     //- Post a non-blocking read of recv from rank from (nothing when empty)
@@ -148,32 +148,6 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
         }
     }
     return got;
-}
-
-
-void Foam::PstreamCommunicator::exchangeInPlace
-(
-    const std::vector<mba::constByteRange>& send,
-    const std::vector<mba::byteRange>& recv
-) const
-{
-    if (!Pstream::parRun())
-    {
-        return;
-    }
-    // Every read posted before any write, then all waited for: only the
-    // ranks with something to say talk, and no sizes travel
-    const label start = UPstream::nRequests();
-    const int me = rank();
-    for (int proci = 0; proci < size(); ++proci)
-    {
-        if (proci != me) postRead(proci, recv[proci]);
-    }
-    for (int proci = 0; proci < size(); ++proci)
-    {
-        if (proci != me) postWrite(proci, send[proci]);
-    }
-    UPstream::waitRequests(start);
 }
 
 
