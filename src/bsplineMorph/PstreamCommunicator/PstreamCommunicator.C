@@ -39,39 +39,7 @@ namespace
 
     //- The tag of the tree sum's rounds (sendReceiveBytes): none of
     //  OpenFOAM's
-    const int pointToPointTag = 28002;
-
-    //- Post a non-blocking read of recv from rank from (nothing when empty)
-    void postRead(const int from, const mba::byteRange& recv)
-    {
-        if (recv.size > 0)
-        {
-            Foam::UIPstream::read
-            (
-                Foam::Pstream::commsTypes::nonBlocking,
-                from,
-                recv.data,
-                std::streamsize(recv.size),
-                pointToPointTag
-            );
-        }
-    }
-
-    //- Post a non-blocking write of send to rank to (nothing when empty)
-    void postWrite(const int to, const mba::constByteRange& send)
-    {
-        if (send.size > 0)
-        {
-            Foam::UOPstream::write
-            (
-                Foam::Pstream::commsTypes::nonBlocking,
-                to,
-                send.data,
-                std::streamsize(send.size),
-                pointToPointTag
-            );
-        }
-    }
+    const int sendReceiveTag = 28002;
 }
 
 
@@ -164,8 +132,28 @@ void Foam::PstreamCommunicator::sendReceiveBytes
         return;
     }
     const label start = UPstream::nRequests();
-    if (from >= 0) postRead(from, recv);
-    if (to >= 0) postWrite(to, send);
+    if (from >= 0 && recv.size > 0)
+    {
+        UIPstream::read
+        (
+            Pstream::commsTypes::nonBlocking,
+            from,
+            recv.data,
+            std::streamsize(recv.size),
+            sendReceiveTag
+        );
+    }
+    if (to >= 0 && send.size > 0)
+    {
+        UOPstream::write
+        (
+            Pstream::commsTypes::nonBlocking,
+            to,
+            send.data,
+            std::streamsize(send.size),
+            sendReceiveTag
+        );
+    }
     UPstream::waitRequests(start);
 }
 
