@@ -95,20 +95,6 @@ void Foam::rigidLayers::findWallPoints()
     {
         wallOf.insert(wallPoints_[i], i);
     }
-    // Each wall point's patch: the first listed one that holds it on any
-    // rank (the same on every decomposition)
-    {
-        labelList pointPatch(mesh_.nPoints(), labelMax);
-        forAllReverse(patchIDs_, k)
-        {
-            for (const label pointi : pbm[patchIDs_[k]].meshPoints())
-            {
-                pointPatch[pointi] = k;
-            }
-        }
-        syncTools::syncPointList(mesh_, pointPatch, minEqOp<label>(), labelMax);
-        wallPatch_ = labelList(UIndirectList<label>(pointPatch, wallPoints_));
-    }
     // The smoothing of the rotations: an averaging (each point gets the
     // means of its faces' points) spreads them by a variance of about half an
     // edge squared, so (innerDistance/edge)^2 of them, by the walls' mean
@@ -370,11 +356,22 @@ void Foam::rigidLayers::plan(const pointField& points0)
     // ranks' that are feet here
     List<Map<label>> compactMap;
     mapPtr_.reset(new mapDistribute(wallIndex, zoneFoot_, compactMap));
-    footPatch_ = wallPatch_;
+
+    // Each foot's patch: the first listed one that holds the wall point on
+    // any rank (the same on every decomposition)
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    labelList pointPatch(mesh_.nPoints(), labelMax);
+    forAllReverse(patchIDs_, k)
+    {
+        for (const label pointi : pbm[patchIDs_[k]].meshPoints())
+        {
+            pointPatch[pointi] = k;
+        }
+    }
+    syncTools::syncPointList(mesh_, pointPatch, minEqOp<label>(), labelMax);
+    footPatch_ = labelList(UIndirectList<label>(pointPatch, wallPoints_));
     mapPtr_->distribute(footPatch_);
     planned_ = true;
-
-    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     const wordList patchNames(pbm.names(), patchIDs_);
     const label nInner = std::count(zoneWeight_.begin(), zoneWeight_.end(), scalar(1));
     Info<< "rigidLayers: " << returnReduce(zonePoints_.size(), sumOp<label>())
