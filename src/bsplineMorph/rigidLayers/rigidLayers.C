@@ -257,6 +257,13 @@ Foam::scalarList Foam::rigidLayers::powerCoeffs(const label n, const scalar tol)
 }
 
 
+Foam::label Foam::rigidLayers::nSweeps(const label n, const scalarList& coeffs)
+{
+    const label m = coeffs.size() - 1;
+    return m >= 1 && m < n ? m : n;
+}
+
+
 void Foam::rigidLayers::power
 (
     tensorField& v,
@@ -266,8 +273,8 @@ void Foam::rigidLayers::power
     List<tensorField>& work
 )
 {
-    const label m = coeffs.size() - 1;
-    if (m < 1 || m >= n)
+    const label m = nSweeps(n, coeffs);
+    if (m == n)
     {
         for (label sweepi = 0; sweepi < n; ++sweepi)
         {
@@ -436,6 +443,27 @@ void Foam::rigidLayers::checkConstrained(const boundaryConstraints& bc) const
 }
 
 
+Foam::vector Foam::rigidLayers::rigidMotion
+(
+    const label j,
+    const vector& arm
+) const
+{
+    const scalar a = mag(arm);
+    if (a <= innerDistance_)
+    {
+        return footDisplacement_[j] + (rotation_[j] & arm) - arm;
+    }
+    // Beyond innerDistance the wall's rotation as a whole (its patch's)
+    // carries on along the arm; the foot's own turn against it acts on the
+    // arm up to innerDistance only, so that the local turns of a deforming
+    // wall (under a crease) do not fan out further
+    const tensor& Rp = patchRotation_[footPatch_[j]];
+    const vector inner = arm*(innerDistance_/a);
+    return footDisplacement_[j] + (Rp & arm) - arm + ((rotation_[j] - Rp) & inner);
+}
+
+
 void Foam::rigidLayers::addControls
 (
     boundaryConstraints& bc,
@@ -483,8 +511,7 @@ void Foam::rigidLayers::addControls
         const label j = zoneFoot_[i];
         if (footFixed[j])
         {
-            const vector& arm = zoneArm_[i];
-            bc.fix(pointi, footDisplacement_[j] + (rotation_[j] & arm) - arm);
+            bc.fix(pointi, rigidMotion(j, zoneArm_[i]));
         }
         else if (footSlide[j].first() > 0)
         {
@@ -532,21 +559,10 @@ void Foam::rigidLayers::apply
         const vector& arm = zoneArm_[i];
         const scalar w = zoneWeight_[i];
         vector& d = displacement[pointi];
-        vector rigid;
+        vector rigid = rigidMotion(j, arm);
         if (w < 1)
         {
-            // In the blend the wall's rotation as a whole (its patch's)
-            // carries on along the arm; the foot's own turn against it acts
-            // on the arm up to innerDistance only, so that the local turns
-            // of a deforming wall (under a crease) do not fan out further
-            const tensor& Rp = patchRotation_[footPatch_[j]];
-            const vector inner = arm*(innerDistance_/max(mag(arm), innerDistance_));
-            rigid = footDisplacement_[j] + (Rp & arm) - arm + ((rotation_[j] - Rp) & inner);
             rigid = d + w*(rigid - d);
-        }
-        else
-        {
-            rigid = footDisplacement_[j] + (rotation_[j] & arm) - arm;
         }
         for (direction c = 0; c < 3; ++c)
         {

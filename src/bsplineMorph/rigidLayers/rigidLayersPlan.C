@@ -116,10 +116,6 @@ void Foam::rigidLayers::findWallPoints()
     const scalar rings = nEdges && edgeSum > 0 ? innerDistance_*nEdges/edgeSum : 0;
     nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
     smoothCoeffs_ = powerCoeffs(nSmooth_, powerTolerance);
-    if (smoothCoeffs_.size() > nSmooth_)
-    {
-        smoothCoeffs_.clear();
-    }
 
     // Each listed face's points as indices into wallPoints_
     DynamicList<label> start(1, 0);
@@ -383,7 +379,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << returnReduce(shellPoints_.size(), sumOp<label>())
         << " of them outermost: control points; rotations smoothed over "
         << nSmooth_ << " rings of faces, in "
-        << (smoothCoeffs_.size() ? smoothCoeffs_.size() - 1 : nSmooth_)
+        << nSweeps(nSmooth_, smoothCoeffs_)
         << " sweeps)" << endl;
 }
 
