@@ -449,8 +449,8 @@ Foam::vector Foam::rigidLayers::rigidMotion
     const vector& arm
 ) const
 {
-    const scalar a = mag(arm);
-    if (a <= innerDistance_)
+    const scalar aSqr = magSqr(arm);
+    if (aSqr <= sqr(innerDistance_))
     {
         return footDisplacement_[j] + (rotation_[j] & arm) - arm;
     }
@@ -459,7 +459,7 @@ Foam::vector Foam::rigidLayers::rigidMotion
     // arm up to innerDistance only, so that the local turns of a deforming
     // wall (under a crease) do not fan out further
     const tensor& Rp = patchRotation_[footPatch_[j]];
-    const vector inner = arm*(innerDistance_/a);
+    const vector inner = arm*(innerDistance_/std::sqrt(aSqr));
     return footDisplacement_[j] + (Rp & arm) - arm + ((rotation_[j] - Rp) & inner);
 }
 
