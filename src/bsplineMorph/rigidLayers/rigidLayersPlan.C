@@ -74,6 +74,50 @@ namespace
         }
         return a.local && !b.local;
     }
+
+    //- The octree's nearest-point search with equal squared distances going
+    //  to preferred(): the octree visits every box no farther than the
+    //  nearest so far, so that one traversal meets every tie
+    template<class Candidate>
+    class nearestPreferredOp
+    {
+        const std::vector<Candidate>& cand_;
+
+    public:
+
+        explicit nearestPreferredOp(const std::vector<Candidate>& cand)
+        :
+            cand_(cand)
+        {}
+
+        void operator()
+        (
+            const labelUList& indices,
+            const point& sample,
+            scalar& nearestDistSqr,
+            label& minIndex,
+            point& nearestPoint
+        ) const
+        {
+            for (const label c : indices)
+            {
+                const scalar distSqr = magSqr(sample - cand_[c].x);
+                if
+                (
+                    distSqr < nearestDistSqr
+                 || (
+                        distSqr == nearestDistSqr && minIndex >= 0
+                     && preferred(cand_[c], cand_[minIndex])
+                    )
+                )
+                {
+                    nearestDistSqr = distSqr;
+                    minIndex = c;
+                    nearestPoint = cand_[c].x;
+                }
+            }
+        }
+    };
 }
 }
 
@@ -239,8 +283,7 @@ void Foam::rigidLayers::findFeet
 )
 {
     // The candidates in an octree: each point's nearest one within
-    // outerDistance, then every candidate at exactly that distance (ties go
-    // to preferred())
+    // outerDistance (equal distances go to preferred())
     zonePoints_.clear();
     zoneFoot_.clear();
     zoneWeight_.clear();
@@ -269,6 +312,7 @@ void Foam::rigidLayers::findFeet
     DynamicList<scalar> weights;
     DynamicList<vector> arms;
     const scalar outerSqr = sqr(outerDistance_);
+    const nearestPreferredOp<footCandidate> nearest(cand);
     forAll(points0, pointi)
     {
         const point& x = points0[pointi];
@@ -276,20 +320,13 @@ void Foam::rigidLayers::findFeet
         {
             continue;   // (most points of a large mesh: no search)
         }
-        const pointIndexHit hit = tree.findNearest(x, outerSqr);
+        const pointIndexHit hit = tree.findNearest(x, outerSqr, nearest);
         if (!hit.hit())
         {
             continue;
         }
-        label best = hit.index();
+        const label best = hit.index();
         const scalar bestSqr = magSqr(x - cand[best].x);
-        for (const label c : tree.findSphere(x, bestSqr))
-        {
-            if (magSqr(x - cand[c].x) == bestSqr && preferred(cand[c], cand[best]))
-            {
-                best = c;
-            }
-        }
         zone.append(pointi);
         feet.append(cand[best].globalIndex);
         weights.append(weight(std::sqrt(bestSqr), innerDistance_, outerDistance_));
