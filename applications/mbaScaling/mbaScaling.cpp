@@ -3,6 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
+//              [--control owner|balanced]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -14,7 +15,12 @@
 // allows), `columns` in a x b x 1 (hierarchical, n (a b 1): every rank holds
 // its share of the top and the bottom). A point on a processor boundary is held by every rank whose cells
 // it touches (each evaluates it); a control point belongs to the lowest of
-// them, as the motion solver counts it.
+// them, as the motion solver counts it. --control balanced instead hands the
+// control points to the ranks in equal blocks whatever their cells (the
+// bottom's to the first half of the ranks, the top's to the second, each
+// plane in a x b blocks as `columns` splits P/2; even rank counts): what
+// the fit costs when the control points are spread evenly over the ranks
+// (each rank then evaluates its cells' points of the top and bottom too).
 //
 // Per rank count: the plan and a first fit, then a step measured (a fit
 // through the plan with new values, and the evaluation; the mean of --steps). Per rank: its control
@@ -57,13 +63,15 @@ struct options
     bool lowerBound = false;
     int steps = 1;
     params::exchangeMode exchange = params::exchangeMode::automatic;
+    bool balanced = false;   ///< --control balanced
 };
 
 [[noreturn]] void usage(const std::string& msg)
 {
     std::cerr << "mbaScaling: " << msg << "\n"
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
-        "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n";
+        "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
+        "                  [--control owner|balanced]\n";
     std::exit(2);
 }
 
@@ -118,6 +126,12 @@ options parse(int argc, char** argv)
                 else if (e == "tree") o.exchange = params::exchangeMode::tree;
                 else usage("--exchange must be automatic, direct, chunked or tree");
             }
+            else if (a == "--control")
+            {
+                const std::string c = val();
+                if (c != "owner" && c != "balanced") usage("--control must be owner or balanced");
+                o.balanced = c == "balanced";
+            }
             else usage("unknown option " + a);
         }
         catch (const std::logic_error&) { usage("bad value for " + a); }
@@ -126,9 +140,11 @@ options parse(int argc, char** argv)
         usage("--decomposition must be simple, hierarchical or columns");
     if (o.n < 2) usage("--n must be at least 2");
     if (o.steps < 1) usage("--steps must be at least 1");
+    if (o.balanced && o.lowerBound) usage("--lower-bound counts the cells' owners: not with --control balanced");
     for (int p : o.ranks)
     {
         if (p < 1) usage("rank counts must be positive");
+        if (o.balanced && p % 2) usage("--control balanced needs even rank counts");
         for (int m : parts(p, o.decomposition))
             if (m > o.n) usage("rank count " + std::to_string(p) + " splits a direction into more parts than cells");
     }
@@ -349,16 +365,33 @@ rankResult runRanks(const options& o, int P)
         };
         std::vector<point<3>> ctrl, eval;
         std::vector<double> v1, v2;
+        auto addControl = [&](const point<3>& x) {
+            ctrl.push_back(x);
+            const point<3> d = displacement(x);
+            for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }
+        };
+        if (o.balanced)
+        {
+            // plane p's points (bottom, top) to ranks p P/2 ... (p + 1) P/2 - 1,
+            // in a x b blocks as `columns` splits P/2
+            const std::array<int, 3> bm = parts(P/2, "columns");
+            for (const long k : {0L, n})
+                for (long j = 0; j <= n; ++j)
+                    for (long i = 0; i <= n; ++i)
+                    {
+                        const long a = std::min<long>(bm[0] - 1, i*bm[0]/(n + 1));
+                        const long b = std::min<long>(bm[1] - 1, j*bm[1]/(n + 1));
+                        if ((k == n)*(P/2) + a + bm[0]*b == r)
+                            addControl(point<3>{double(i)/n, double(j)/n, double(k)/n});
+                    }
+        }
         for (long k = lo[2]; k <= hi[2]; ++k)
             for (long j = lo[1]; j <= hi[1]; ++j)
                 for (long i = lo[0]; i <= hi[0]; ++i)
                 {
                     const point<3> x{double(i)/n, double(j)/n, double(k)/n};
-                    if (k != 0 && k != n) { eval.push_back(x); continue; }
-                    if (owner(i, j, k) != r) continue;
-                    ctrl.push_back(x);
-                    const point<3> d = displacement(x);
-                    for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }
+                    if ((k != 0 && k != n) || o.balanced) eval.push_back(x);
+                    else if (owner(i, j, k) == r) addControl(x);
                 }
         std::set<int> nb;
         for (int q = 0; q < P; ++q)
@@ -441,7 +474,9 @@ int main(int argc, char** argv)
     const long n = o.n;
     const long nControl = 2*(n + 1)*(n + 1);
     std::printf("mbaScaling: twisted cube, %ld^3 cells, %ld control points (top and bottom), %ld evaluated points, "
-                "decomposition %s\n", n, nControl, (n + 1)*(n + 1)*(n + 1) - nControl, o.decomposition.c_str());
+                "decomposition %s, control points %s\n", n, nControl,
+                (n + 1)*(n + 1)*(n + 1) - (o.balanced ? 0 : nControl),
+                o.decomposition.c_str(), o.balanced ? "in balanced blocks (--control balanced)" : "of their cells' ranks");
     std::printf("per step (a fit through the plan and the evaluation); share: 48 bytes per control point of the "
                 "rank's mean share of the boundary\n\n");
     std::printf("%5s %9s %8s %8s %11s %11s %8s %6s %6s %5s %9s %9s %9s %9s %8s\n", "ranks", "parts", "ctrl max",
@@ -476,14 +511,14 @@ int main(int argc, char** argv)
             std::printf("%5d %9s %8.0f %8.0f %11.0f %11.0f %8.2f %6.0f %6.1f %5d %9.4f %9.4f %9.4f %9.4f %8.2f\n",
                         P, pstr.c_str(), ctrl.max, nb.max, bytes.max, bytes.mean, bytes.max/share, msgs.max,
                         msgs.mean, res.levels, fit.max, fit.mean, ev.max, ev.mean, work.max/work.mean);
-            std::printf("RESULT n=%ld decomposition=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
+            std::printf("RESULT n=%ld decomposition=%s assignment=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
                         "ctrl_mean=%.1f eval_max=%.0f eval_mean=%.1f neighbours_max=%.0f recv_bytes_max=%.0f "
                         "recv_bytes_mean=%.1f share_bytes=%.1f messages_max=%.0f messages_mean=%.2f "
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
                         "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f\n",
-                        n, o.decomposition.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
+                        n, o.decomposition.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
                         res.maxResidual, bound.max);
