@@ -309,13 +309,15 @@ void scatterStencil(double* delta, const stencilTiles<D>& tid, const stencil<D>&
 #ifdef MBA_WIDE_VECTORS
 /// scatterStencil's add in vectors of four doubles: whole tile rows (as in
 /// sweepStencilWide) += w u, u holding w_c r at node OZ + c of the tile rows
-/// and 0 at their other nodes
+/// and 0 at their other nodes. The rows of absent tiles go to a sink, zeroed
+/// first: it is read and added to like a row (unwritten memory may hold a
+/// signalling NaN, a trapped floating-point exception under FOAM_SIGFPE)
 template <int D, int NC, int OZ>
 MBA_WIDE_TARGET void scatterStencilWide(double* delta, const stencilTiles<D>& tid, const stencil<D>& st,
                                         const double* r)
 {
     constexpr int R = 4*NC;
-    double u[2*R] = {}, sink[R];
+    double u[2*R] = {}, sink[R] = {};
     lastDirection<NC>(st.w[D - 1], r, OZ, u);
     const vrow<R, 4> ua = vrow<R, 4>::load(u), ub = vrow<R, 4>::load(u + R);
     auto addRow = [delta, &tid, &sink](int t, int n, double w, const vrow<R, 4>& v) __attribute__((always_inline)) {
