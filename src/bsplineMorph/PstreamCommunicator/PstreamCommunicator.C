@@ -37,9 +37,41 @@ namespace
         return mba::bytes(l.begin(), l.end());
     }
 
-    //- The tag of the tree sum's rounds (sendReceiveBytes): none of
-    //  OpenFOAM's
-    const int sendReceiveTag = 28002;
+    //- The tag of the point-to-point messages whose sizes both sides know
+    //  (exchangeInPlace, sendReceiveBytes): none of OpenFOAM's
+    const int pointToPointTag = 28002;
+
+    //- Post a non-blocking read of recv from rank from (nothing when empty)
+    void postRead(const int from, const mba::byteRange& recv)
+    {
+        if (recv.size > 0)
+        {
+            Foam::UIPstream::read
+            (
+                Foam::Pstream::commsTypes::nonBlocking,
+                from,
+                recv.data,
+                std::streamsize(recv.size),
+                pointToPointTag
+            );
+        }
+    }
+
+    //- Post a non-blocking write of send to rank to (nothing when empty)
+    void postWrite(const int to, const mba::constByteRange& send)
+    {
+        if (send.size > 0)
+        {
+            Foam::UOPstream::write
+            (
+                Foam::Pstream::commsTypes::nonBlocking,
+                to,
+                send.data,
+                std::streamsize(send.size),
+                pointToPointTag
+            );
+        }
+    }
 }
 
 
@@ -119,6 +151,32 @@ std::vector<mba::bytes> Foam::PstreamCommunicator::exchangeBytes
 }
 
 
+void Foam::PstreamCommunicator::exchangeInPlace
+(
+    const std::vector<mba::constByteRange>& send,
+    const std::vector<mba::byteRange>& recv
+) const
+{
+    if (!Pstream::parRun())
+    {
+        return;
+    }
+    // Every read posted before any write, then all waited for: only the
+    // ranks with something to say talk, and no sizes travel
+    const label start = UPstream::nRequests();
+    const int me = rank();
+    for (int proci = 0; proci < size(); ++proci)
+    {
+        if (proci != me) postRead(proci, recv[proci]);
+    }
+    for (int proci = 0; proci < size(); ++proci)
+    {
+        if (proci != me) postWrite(proci, send[proci]);
+    }
+    UPstream::waitRequests(start);
+}
+
+
 void Foam::PstreamCommunicator::sendReceiveBytes
 (
     int to,
@@ -132,28 +190,8 @@ void Foam::PstreamCommunicator::sendReceiveBytes
         return;
     }
     const label start = UPstream::nRequests();
-    if (from >= 0 && recv.size > 0)
-    {
-        UIPstream::read
-        (
-            Pstream::commsTypes::nonBlocking,
-            from,
-            recv.data,
-            std::streamsize(recv.size),
-            sendReceiveTag
-        );
-    }
-    if (to >= 0 && send.size > 0)
-    {
-        UOPstream::write
-        (
-            Pstream::commsTypes::nonBlocking,
-            to,
-            send.data,
-            std::streamsize(send.size),
-            sendReceiveTag
-        );
-    }
+    if (from >= 0) postRead(from, recv);
+    if (to >= 0) postWrite(to, send);
     UPstream::waitRequests(start);
 }
 
