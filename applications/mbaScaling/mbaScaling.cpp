@@ -20,7 +20,8 @@
 // bottom's to the first half of the ranks, the top's to the second, each
 // plane in a x b blocks as `columns` splits P/2; even rank counts): what
 // the fit costs when the control points are spread evenly over the ranks
-// (each rank then evaluates its cells' points of the top and bottom too).
+// (a rank's cells' points of the top and bottom are then another rank's
+// control points: prescribed, not evaluated, as in the motion solver).
 //
 // Per rank count: the plan and a first fit, then a step measured (a fit
 // through the plan with new values, and the evaluation; the mean of --steps). Per rank: its control
@@ -390,8 +391,8 @@ rankResult runRanks(const options& o, int P)
                 for (long i = lo[0]; i <= hi[0]; ++i)
                 {
                     const point<3> x{double(i)/n, double(j)/n, double(k)/n};
-                    if ((k != 0 && k != n) || o.balanced) eval.push_back(x);
-                    else if (owner(i, j, k) == r) addControl(x);
+                    if (k != 0 && k != n) eval.push_back(x);
+                    else if (!o.balanced && owner(i, j, k) == r) addControl(x);
                 }
         std::set<int> nb;
         for (int q = 0; q < P; ++q)
@@ -475,7 +476,7 @@ int main(int argc, char** argv)
     const long nControl = 2*(n + 1)*(n + 1);
     std::printf("mbaScaling: twisted cube, %ld^3 cells, %ld control points (top and bottom), %ld evaluated points, "
                 "decomposition %s, control points %s\n", n, nControl,
-                (n + 1)*(n + 1)*(n + 1) - (o.balanced ? 0 : nControl),
+                (n + 1)*(n + 1)*(n + 1) - nControl,
                 o.decomposition.c_str(), o.balanced ? "in balanced blocks (--control balanced)" : "of their cells' ranks");
     std::printf("per step (a fit through the plan and the evaluation); share: 48 bytes per control point of the "
                 "rank's mean share of the boundary\n\n");
