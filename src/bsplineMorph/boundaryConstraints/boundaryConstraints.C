@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "boundaryConstraints.H"
+#include "sumsAndMaxima.H"
 #include "valuePointPatchFields.H"
 #include "syncTools.H"
 #include "globalMeshData.H"
@@ -418,6 +419,21 @@ void Foam::boundaryConstraints::collectControls()
     }
     controlPoints_.transfer(ctrl);
     projected_.transfer(proj);
+    nControlGlobal_ = -1;
+    nProjectedGlobal_ = -1;
+}
+
+
+void Foam::boundaryConstraints::countGlobal() const
+{
+    if (nControlGlobal_ < 0)
+    {
+        scalarList counts({scalar(controlPoints_.size()), scalar(projected_.size())});
+        scalarList none;
+        sumsAndMaxima(counts, none);
+        nControlGlobal_ = label(counts[0]);
+        nProjectedGlobal_ = label(counts[1]);
+    }
 }
 
 
@@ -561,13 +577,15 @@ void Foam::boundaryConstraints::slide(const label pointi, const pointConstraint&
 
 Foam::label Foam::boundaryConstraints::nControlGlobal() const
 {
-    return returnReduce(controlPoints_.size(), sumOp<label>());
+    countGlobal();
+    return nControlGlobal_;
 }
 
 
 Foam::label Foam::boundaryConstraints::nRefitGlobal() const
 {
-    return returnReduce(projected_.size(), sumOp<label>()) + nCyclicGlobal_;
+    countGlobal();
+    return nProjectedGlobal_ + nCyclicGlobal_;
 }
 
 

@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "invertedCellCheck.H"
+#include "sumsAndMaxima.H"
 #include "vectorWidth.hpp"
 
 #include <string>
@@ -527,11 +528,24 @@ Foam::invertedCellCheck::check(const pointField& points) const
         }
     }
     r.cells.transfer(invalid);
-    reduce(r.nInvalid, sumOp<label>());
-    reduce(r.nNonPositive, sumOp<label>());
-    reduce(r.nFolded, sumOp<label>());
-    reduce(r.nJudged, sumOp<label>());
-    r.where.reduce();
+    // The counts and the box over all ranks, in one reduction
+    scalarList counts
+    ({
+        scalar(r.nInvalid), scalar(r.nNonPositive), scalar(r.nFolded), scalar(r.nJudged)
+    });
+    const point& lo = r.where.min();
+    const point& hi = r.where.max();
+    scalarList extents({-lo.x(), -lo.y(), -lo.z(), hi.x(), hi.y(), hi.z()});
+    sumsAndMaxima(counts, extents);
+    r.nInvalid = label(counts[0]);
+    r.nNonPositive = label(counts[1]);
+    r.nFolded = label(counts[2]);
+    r.nJudged = label(counts[3]);
+    r.where = boundBox
+    (
+        point(-extents[0], -extents[1], -extents[2]),
+        point(extents[3], extents[4], extents[5])
+    );
     return r;
 }
 

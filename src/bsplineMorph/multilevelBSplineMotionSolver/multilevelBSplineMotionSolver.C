@@ -17,6 +17,7 @@ License
 
 #include "multilevelBSplineMotionSolver.H"
 #include "coeffsInput.H"
+#include "sumsAndMaxima.H"
 #include "addToRunTimeSelectionTable.H"
 #include "OStringStream.H"
 #include "Enum.H"
@@ -172,13 +173,10 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
             }
         }
     }
-    // (two reductions for the six figures: each costs a tree of messages)
-    List<scalar> sums({nodes, bytes, messages, scalar(plan_.bytes())});
-    List<scalar> maxima({bytes, messages});
-    Pstream::listCombineGather(sums, plusEqOp<scalar>());
-    Pstream::listCombineScatter(sums);
-    Pstream::listCombineGather(maxima, maxEqOp<scalar>());
-    Pstream::listCombineScatter(maxima);
+    // (the six figures in one reduction)
+    scalarList sums({nodes, bytes, messages, scalar(plan_.bytes())});
+    scalarList maxima({bytes, messages});
+    sumsAndMaxima(sums, maxima);
     nodes = sums[0];
     bytes = sums[1];
     messages = sums[2];
