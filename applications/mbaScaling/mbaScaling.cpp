@@ -3,7 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
-//              [--control owner|balanced] [--evaluation owner|balanced]
+//              [--control owner|balanced]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -22,13 +22,6 @@
 // the fit costs when the control points are spread evenly over the ranks
 // (a rank's cells' points of the top and bottom are then another rank's
 // control points: prescribed, not evaluated, as in the motion solver).
-// --evaluation balanced hands evaluation points from the ranks that work more
-// than 1.1 times the mean to those that work less (mba::evaluationBalance,
-// the work counted from the control points, levels and evaluation points),
-// plans again with them, and
-// returns their values to their own ranks every step (in the step's bytes
-// and messages); the values are checked bitwise against those of the own
-// points' plan.
 //
 // Per rank count: the plan and a first fit, then a step measured (a fit
 // through the plan with new values, and the evaluation; the mean of --steps). Per rank: its control
@@ -43,7 +36,6 @@
 // (lowerBoundBytes), against the share; --exchange the levels' exchange
 // (params::exchange; default automatic, the motion solver's).
 
-#include "evaluationBalance.hpp"
 #include "multilevel.hpp"
 
 #include <time.h>
@@ -73,7 +65,6 @@ struct options
     int steps = 1;
     params::exchangeMode exchange = params::exchangeMode::automatic;
     bool balanced = false;   ///< --control balanced
-    bool balanceEvaluation = false;   ///< --evaluation balanced
 };
 
 [[noreturn]] void usage(const std::string& msg)
@@ -81,7 +72,7 @@ struct options
     std::cerr << "mbaScaling: " << msg << "\n"
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
-        "                  [--control owner|balanced] [--evaluation owner|balanced]\n";
+        "                  [--control owner|balanced]\n";
     std::exit(2);
 }
 
@@ -141,12 +132,6 @@ options parse(int argc, char** argv)
                 const std::string c = val();
                 if (c != "owner" && c != "balanced") usage("--control must be owner or balanced");
                 o.balanced = c == "balanced";
-            }
-            else if (a == "--evaluation")
-            {
-                const std::string e = val();
-                if (e != "owner" && e != "balanced") usage("--evaluation must be owner or balanced");
-                o.balanceEvaluation = e == "balanced";
             }
             else usage("unknown option " + a);
         }
@@ -338,9 +323,6 @@ struct rankFigures
     double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
     double lowerBound = 0;   ///< lowerBoundBytes
-    double moved = 0;        ///< evaluation points handed to other ranks (--evaluation balanced)
-    double imbalance = 1;    ///< the counted work's max/mean before the balance (--evaluation balanced)
-    double balanceError = 0; ///< largest difference of the values from the own points' plan
 };
 
 /// First index of part p of n cells in m parts, and the point range of the part
@@ -426,37 +408,12 @@ rankResult runRanks(const options& o, int P)
         f.evaluation = double(eval.size());
         f.neighbours = double(nb.size());
         double t = threadSeconds();
-        const pointsView<3> ctrlView(ctrl.empty() ? nullptr : ctrl[0].data(), ctrl.size());
-        auto mbaPtr = std::unique_ptr<multilevel<3>>(new multilevel<3>(comm, prm, 3, ctrlView, {},
-                          pointsView<3>(eval.empty() ? nullptr : eval[0].data(), eval.size())));
-        mbaPtr->fit(v1);
+        multilevel<3> mba(comm, prm, 3, pointsView<3>(ctrl.empty() ? nullptr : ctrl[0].data(), ctrl.size()), {},
+                          pointsView<3>(eval.empty() ? nullptr : eval[0].data(), eval.size()));
+        mba.fit(v1);
         std::vector<double> out;
-        mbaPtr->evaluate(out);
+        mba.evaluate(out);
         f.planCpu = threadSeconds() - t;
-
-        // --evaluation balanced: the points handed over (by the counted
-        // work), a plan of the points this rank then evaluates
-        std::unique_ptr<evaluationBalance<3>> balance;
-        std::vector<double> own, reference;
-        if (o.balanceEvaluation)
-        {
-            mbaPtr->fit(v2);
-            mbaPtr->evaluate(own);
-            reference = own;
-            balance.reset(new evaluationBalance<3>(comm, pointsView<3>(eval),
-                workOf(std::int64_t(ctrl.size()), mbaPtr->report().levels, std::int64_t(eval.size())), 1.1));
-            f.moved = double(balance->nSent());
-            f.imbalance = balance->imbalance();
-            if (balance->moves().empty()) balance.reset();
-            else
-            {
-                mbaPtr.reset(new multilevel<3>(comm, prm, 3, ctrlView, {}, balance->points()));
-                mbaPtr->fit(v1);
-                mbaPtr->evaluate(out);
-                f.evaluation = double(balance->points().size);
-            }
-        }
-        multilevel<3>& mba = *mbaPtr;
 
         // the step: a fit through the plan, the evaluation (the mean of --steps)
         const trafficStats before = comm.traffic();
@@ -470,30 +427,16 @@ rankResult runRanks(const options& o, int P)
             c = comm.seconds();
             t = threadSeconds();
             mba.evaluate(out);
-            if (balance) balance->restore(out, 3, own);
             f.evalCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
         }
         const fitReport& rep = mba.report();
-        const trafficStats after = comm.traffic();
-        if (balance)
-        {
-            // the values at the own points, those of the own points' plan to
-            // round-off (1e-12 of the cube)
-            mba.fit(v2);
-            mba.evaluate(out);
-            balance->restore(out, 3, own);
-            double most = 0;
-            for (std::size_t i = 0; i < own.size(); ++i) most = std::max(most, std::abs(own[i] - reference[i]));
-            f.balanceError = most;
-            comm.check(own.size() == reference.size() && most <= 1e-12,
-                       "mbaScaling: the balanced evaluation differs from the own points' plan");
-        }
         if (P > 1 && o.lowerBound)
         {
             std::vector<point<3>> query(ctrl);
             query.insert(query.end(), eval.begin(), eval.end());
             f.lowerBound = lowerBoundBytes(mba.dom(), rep.levels, n, query, r, owner);
         }
+        const trafficStats after = comm.traffic();
         f.bytes = double(after.bytesReceived - before.bytesReceived)/o.steps;
         f.messages = double(after.messagesReceived - before.messagesReceived)/o.steps;
         f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes)/o.steps;
@@ -560,9 +503,6 @@ int main(int argc, char** argv)
             const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
             const summary plan = over(v, [](const rankFigures& f) { return f.planCpu; });
             const summary bound = over(v, [](const rankFigures& f) { return f.lowerBound; });
-            const summary moved = over(v, [](const rankFigures& f) { return f.moved; });
-            const summary before = over(v, [](const rankFigures& f) { return f.imbalance; });
-            const summary balanceErr = over(v, [](const rankFigures& f) { return f.balanceError; });
             // messages per neighbour and level: the bound the exchange keeps
             const summary perNb = over(v, [&](const rankFigures& f) {
                 return f.neighbours > 0 ? f.messages/(f.neighbours*res.levels) : 0.0;
@@ -578,13 +518,11 @@ int main(int argc, char** argv)
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
-                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f evaluation=%s moved_max=%.0f "
-                        "imbalance_before=%.3f balance_error=%.1e\n",
+                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f\n",
                         n, o.decomposition.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
-                        res.maxResidual, bound.max, o.balanceEvaluation ? "balanced" : "owner", moved.max,
-                        before.max, balanceErr.max);
+                        res.maxResidual, bound.max);
             if (o.lowerBound && P > 1)
                 std::printf("  least any exchange of values per level could make the busiest rank receive: %.0f bytes, "
                             "%.2f x the share\n", bound.max, bound.max/share);
