@@ -301,19 +301,23 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
 TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bsplineMorph][errors]")
 {
     using Catch::Matchers::Contains;
-    // (out of range: the entry, its value and the allowed range)
+    // (out of range: the entry, its value and the allowed range; a word
+    // that is not one of its values: the entry, the word, the valid ones)
     CHECK_THAT(errorOf("tolerance -1;"), Contains("tolerance") && Contains("-1") && Contains("at least 0"));
     CHECK_THAT(errorOf("maxLevels 0;"), Contains("maxLevels") && Contains("from 1 to 30"));
     CHECK_THAT(errorOf("maxLevels 100;"), Contains("'maxLevels' is 100") && Contains("from 1 to 30") && Contains("default 12"));
     CHECK_THAT(errorOf("initialGrid 0;"), Contains("initialGrid") && Contains("from 1 to 1048576"));
     CHECK_THAT(errorOf("bucketTiles 0;"), Contains("bucketTiles") && Contains("at least 1"));
     const std::string approx = errorOf("initialApproximation quadratic;");
-    CHECK_THAT(approx, Contains("quadratic") && Contains("affine") && Contains("none"));
+    CHECK_THAT(approx, Contains("'initialApproximation' is 'quadratic'") && Contains("affine") && Contains("none")
+        && Contains("default affine"));
     const std::string inverted = errorOf("invertedCells maybe;");
-    CHECK_THAT(inverted, Contains("maybe") && Contains("fatal") && Contains("warn"));
+    CHECK_THAT(inverted, Contains("'invertedCells' is 'maybe'") && Contains("fatal") && Contains("warn")
+        && Contains("default fatal"));
     CHECK_THAT(errorOf("relativeTolerance perhaps;"), Contains("perhaps"));
     const std::string exchange = errorOf("exchange sideways;");
-    CHECK_THAT(exchange, Contains("sideways") && Contains("automatic") && Contains("direct") && Contains("chunked") && Contains("tree"));
+    CHECK_THAT(exchange, Contains("'exchange' is 'sideways'") && Contains("automatic") && Contains("direct")
+        && Contains("chunked") && Contains("tree"));
     CHECK(errorOf("tolerance 1e-8; maxLevels 8; initialGrid 2; initialApproximation none;") == "no error");
 }
 
@@ -347,7 +351,7 @@ TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][
 {
     using Catch::Matchers::Contains;
     const std::string function = errorOf("function gaussian;", "RBF");
-    CHECK_THAT(function, Contains("gaussian") && Contains("inverseMultiquadric")
+    CHECK_THAT(function, Contains("'function' is 'gaussian'") && Contains("inverseMultiquadric")
         && Contains("thinPlateSpline") && Contains("wendlandC2"));
     CHECK_THAT(errorOf("shapeParameter 0;", "RBF"), Contains("shapeParameter"));
     CHECK_THAT(errorOf("supportRadius -1;", "RBF"), Contains("supportRadius"));
@@ -356,7 +360,7 @@ TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][
     CHECK_THAT(errorOf("greedyBatch 0;", "RBF"), Contains("greedyBatch"));
     CHECK_THAT(errorOf("function thinPlateSpline; polynomial false;", "RBF"),
         Contains("thinPlateSpline") && Contains("polynomial"));
-    CHECK_THAT(errorOf("invertedCells maybe;", "RBF"), Contains("maybe"));
+    CHECK_THAT(errorOf("invertedCells maybe;", "RBF"), Contains("'invertedCells' is 'maybe'"));
     CHECK(errorOf("function wendlandC2; supportRadius 2; polynomial false;", "RBF") == "no error");
 }
 

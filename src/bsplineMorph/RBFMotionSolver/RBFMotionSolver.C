@@ -175,7 +175,7 @@ void Foam::RBFMotionSolver::readCoeffs()
 {
     const dictionary& dict = coeffDict();
     params_.function =
-        kernelNames.lookupOrDefault("function", dict, rbf::kernel::thinPlateSpline);
+        coeffsInput::getEnum(dict, "function", kernelNames, rbf::kernel::thinPlateSpline);
     params_.shapeParameter =
         coeffsInput::getInRange<scalar>(dict, "shapeParameter", 0.05, SMALL);
     params_.supportRadius =

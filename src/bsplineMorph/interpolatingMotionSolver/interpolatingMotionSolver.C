@@ -56,9 +56,9 @@ namespace Foam
 
         bool readInvertedCellsFatal(const dictionary& dict)
         {
-            return onInvertedNames.lookupOrDefault
+            return coeffsInput::getEnum
             (
-                "invertedCells", dict, onInverted::fatal
+                dict, "invertedCells", onInvertedNames, onInverted::fatal
             ) == onInverted::fatal;
         }
     }

@@ -232,14 +232,15 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     params_.initialGrid =
         coeffsInput::getInRange<label>(dict, "initialGrid", 1, 1, 1 << 20);
     params_.affine =
-        initialApproximationNames.lookupOrDefault
+        coeffsInput::getEnum
         (
-            "initialApproximation", dict, initialApproximation::affine
+            dict, "initialApproximation", initialApproximationNames,
+            initialApproximation::affine
         ) == initialApproximation::affine;
     params_.bucketTiles = coeffsInput::getInRange<label>(dict, "bucketTiles", 32, 1);
-    params_.exchange = exchangeNames.lookupOrDefault
+    params_.exchange = coeffsInput::getEnum
     (
-        "exchange", dict, mba::params::exchangeMode::automatic
+        dict, "exchange", exchangeNames, mba::params::exchangeMode::automatic
     );
     warnUnknownKeywords
     ({
