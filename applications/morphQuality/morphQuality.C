@@ -21,8 +21,9 @@ Group
 
 Description
     Compares a morphed mesh with its undeformed one (constant/polyMesh/points)
-    at each selected time, prints the measures and appends them to
-    postProcessing/morphQuality.dat (one row per time):
+    at each selected time, prints the measures and writes them to
+    postProcessing/morphQuality.dat (one row per selected time; the file is
+    written anew by each run):
 
     - maxNonOrth     largest face non-orthogonality [deg]
     - maxSkewness    largest face skewness (checkMesh's measure)
@@ -39,8 +40,10 @@ Description
       [deg]: mean and worst (largest magnitude) of each.
 
     With -layers N (N > 0) the same two measures for each of the first N
-    prism layers, printed as a table and appended to
-    postProcessing/morphQualityLayers.dat (one row per time and layer: time
+    prism layers (those that the columns reach: fewer where the mesh ends
+    first), printed as a table and written to
+    postProcessing/morphQualityLayers.dat (a run without -layers removes
+    it; one row per time and layer: time
     layer nCells meanHeightChange worstHeightChange meanAngleChange
     worstAngleChange). A column of layer cells starts at each wall face:
     layer 1 is its owner cell, and the face of a layer cell opposite to its
@@ -377,7 +380,20 @@ int main(int argc, char *argv[])
         FatalErrorInFunction
             << "-layers " << nLayers << ": expected N >= 0" << exit(FatalError);
     }
-    const List<layerCells> layers(walkLayers(mesh, wallFaces, nLayers));
+    List<layerCells> layers(walkLayers(mesh, wallFaces, nLayers));
+    // The columns end where the mesh does: the layers past the deepest cell
+    // are not measured (they have no cells to compare)
+    forAll(layers, k)
+    {
+        if (returnReduce(layers[k].cells.size(), sumOp<label>()) == 0)
+        {
+            Info<< "-layers " << nLayers << ": the columns on "
+                << flatOutput(wallNames) << " end after " << k
+                << " layers; measuring those" << nl << endl;
+            layers.setSize(k);
+            break;
+        }
+    }
 
     // The undeformed mesh
     pointIOField points0
@@ -416,11 +432,18 @@ int main(int argc, char *argv[])
             << nl;
     }
     autoPtr<OFstream> layersOsPtr;
+    const fileName layersFile(runTime.globalPath()/"postProcessing"/"morphQualityLayers.dat");
+    if (Pstream::master() && nLayers == 0 && isFile(layersFile))
+    {
+        // (a table of an earlier run with -layers would not match this one's)
+        rm(layersFile);
+        Info<< "Removed " << layersFile << " of an earlier run with -layers" << nl << endl;
+    }
     if (Pstream::master() && nLayers > 0)
     {
         layersOsPtr.reset
         (
-            new OFstream(runTime.globalPath()/"postProcessing"/"morphQualityLayers.dat")
+            new OFstream(layersFile)
         );
         layersOsPtr()
             << "# morphQuality -layers " << nLayers
