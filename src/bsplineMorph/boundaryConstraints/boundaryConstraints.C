@@ -31,6 +31,7 @@ License
 #include "processorPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
 
+#include <algorithm>
 #include <cmath>
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
@@ -88,6 +89,51 @@ bool Foam::boundaryConstraints::axisMask(const pointConstraint& pc, bool mask[3]
 }
 
 
+// * * * * * * * * * * * * * * * Global Functions  * * * * * * * * * * * * * //
+
+Foam::boolList Foam::ownedPoints(const polyMesh& mesh)
+{
+    const globalMeshData& gd = mesh.globalData();
+    const labelList& coupledPoints = gd.coupledPatch().meshPoints();
+    labelList owner(coupledPoints.size(), Pstream::myProcNo());
+    globalMeshData::syncData
+    (
+        owner,
+        gd.globalCoPointSlaves(),
+        labelListList(0),
+        gd.globalCoPointSlavesMap(),
+        minEqOp<label>()
+    );
+    boolList owned(mesh.nPoints(), true);
+    forAll(coupledPoints, i)
+    {
+        owned[coupledPoints[i]] = owner[i] == Pstream::myProcNo();
+    }
+    return owned;
+}
+
+
+Foam::label Foam::nOwnedGlobal(const boolList& owned, const labelUList& points)
+{
+    label n = 0;
+    for (const label pointi : points)
+    {
+        n += owned[pointi];
+    }
+    return returnReduce(n, sumOp<label>());
+}
+
+
+Foam::label Foam::nOwnedGlobal(const boolList& owned)
+{
+    return returnReduce
+    (
+        label(std::count(owned.begin(), owned.end(), true)),
+        sumOp<label>()
+    );
+}
+
+
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::boundaryConstraints::boundaryConstraints
@@ -108,26 +154,7 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
 
-    // Ownership: the lowest rank holding a point (its collocated copies
-    // only: the points a cyclic coupling joins are different points, each
-    // with its owner)
-    const globalMeshData& gd = mesh.globalData();
-    const labelList& coupledPoints = gd.coupledPatch().meshPoints();
-    labelList owner(coupledPoints.size(), Pstream::myProcNo());
-    globalMeshData::syncData
-    (
-        owner,
-        gd.globalCoPointSlaves(),
-        labelListList(0),
-        gd.globalCoPointSlavesMap(),
-        minEqOp<label>()
-    );
-    owned_.setSize(mesh.nPoints());
-    owned_ = true;
-    forAll(coupledPoints, i)
-    {
-        owned_[coupledPoints[i]] = owner[i] == Pstream::myProcNo();
-    }
+    owned_ = ownedPoints(mesh);
 
     // The points of every patch but empty ones, and of those whose
     // conditions can fix or slide them (not coupled) on any rank: a

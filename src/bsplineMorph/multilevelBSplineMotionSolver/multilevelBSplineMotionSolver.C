@@ -324,8 +324,8 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
     const label nControl = bc.nControlGlobal();
     Info<< type() << ": " << (refit ? "re-fit " : "") << "plan for "
         << nControl << " control points, "
-        << returnReduce(points0().size(), sumOp<label>()) << " mesh points ("
-        << returnReduce(evalPoints().size(), sumOp<label>()) << " interpolated), " << D << "D";
+        << nOwnedGlobal(bc.owned()) << " mesh points ("
+        << nOwnedGlobal(bc.owned(), evalPoints()) << " interpolated), " << D << "D";
     if (Pstream::parRun())
     {
         // The fit's work is per control point: how evenly the ranks hold them

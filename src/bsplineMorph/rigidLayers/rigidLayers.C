@@ -609,10 +609,4 @@ Foam::label Foam::rigidLayers::nCellsInBlend(const labelList& cells) const
 }
 
 
-Foam::label Foam::rigidLayers::nZonePointsGlobal() const
-{
-    return returnReduce(zonePoints_.size(), sumOp<label>());
-}
-
-
 // ************************************************************************* //

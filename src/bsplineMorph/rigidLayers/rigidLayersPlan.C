@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "rigidLayers.H"
+#include "boundaryConstraints.H"
 #include "emptyPolyPatch.H"
 #include "syncTools.H"
 #include "globalIndex.H"
@@ -414,14 +415,23 @@ void Foam::rigidLayers::plan(const pointField& points0)
     mapPtr_->distribute(footPatch_);
     planned_ = true;
     const wordList patchNames(pbm.names(), patchIDs_);
-    const label nInner = std::count(zoneWeight_.begin(), zoneWeight_.end(), scalar(1));
-    Info<< "rigidLayers: " << returnReduce(zonePoints_.size(), sumOp<label>())
+    // (each point counted once, however many ranks hold it)
+    const boolList owned(ownedPoints(mesh_));
+    DynamicList<label> inner(zonePoints_.size());
+    forAll(zonePoints_, i)
+    {
+        if (zoneWeight_[i] == 1)
+        {
+            inner.append(zonePoints_[i]);
+        }
+    }
+    Info<< "rigidLayers: " << nOwnedGlobal(owned, zonePoints_)
         << " points within outerDistance " << outerDistance_ << " of "
-        << returnReduce(wallPoints_.size(), sumOp<label>()) << " wall points on patches "
+        << nOwnedGlobal(owned, wallPoints_) << " wall points on patches "
         << flatOutput(patchNames)
-        << " (" << returnReduce(nInner, sumOp<label>())
+        << " (" << nOwnedGlobal(owned, inner)
         << " within innerDistance " << innerDistance_ << ", "
-        << returnReduce(shellPoints_.size(), sumOp<label>())
+        << nOwnedGlobal(owned, shellPoints_)
         << " of them outermost: control points; rotations smoothed over "
         << nSmooth_ << " rings of faces, in "
         << nSweeps(nSmooth_, smoothCoeffs_)
