@@ -23,6 +23,7 @@ License
 #include "OFstream.H"
 #include "OSspecific.H"
 #include "coeffsInput.H"
+#include "logPrecision.H"
 #include "hugePages.hpp"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
@@ -419,6 +420,7 @@ void Foam::interpolatingMotionSolver::correctBoundaryValues
 
 void Foam::interpolatingMotionSolver::solve()
 {
+    const logPrecision digits;
     const clockTime timer;
     const bool changed = updateControls();
     const scalar conditionsSeconds = timer.elapsedTime();
