@@ -31,14 +31,25 @@ a header again where the columns change):
 Read columns by name (row["maxNonOrth"]), never by position: the programs may
 add columns.
 """
-import glob, os, re
+import glob, os, re, struct, sys
 
 # ---------------------------------------------------------------- points
 
 def readPoints(path):
-    """The points of an ascii pointField file (after its FoamFile header)"""
-    txt = open(path).read()
-    body = txt[txt.index("(", txt.index("}")) :]
+    """The points of a pointField file (after its FoamFile header), ascii or
+    binary (double precision) as its header says"""
+    if not os.path.isfile(path):
+        raise SystemExit("%s: no points file %s" % (os.path.basename(sys.argv[0]), path))
+    raw = open(path, "rb").read()
+    end = raw.index(b"}")
+    if re.search(rb"format\s+binary\s*;", raw[:end]):
+        m = re.compile(rb"(\d+)\s*\(").search(raw, end + 1)   # (past the // * * * line)
+        if not m:
+            raise SystemExit("%s: %s: no point count after the header" % (os.path.basename(sys.argv[0]), path))
+        n = int(m.group(1))
+        v = struct.unpack_from("<%dd" % (3 * n), raw, m.end())
+        return [v[3 * i:3 * i + 3] for i in range(n)]
+    body = raw[raw.index(b"(", end):].decode()
     nums = re.findall(r"\(([^()]+)\)", body)
     return [tuple(float(v) for v in s.split()) for s in nums]
 

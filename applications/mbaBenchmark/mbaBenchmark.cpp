@@ -47,11 +47,14 @@ struct options
 
 [[noreturn]] void usage(const std::string& msg)
 {
-    std::cerr << "mbaBenchmark: " << msg << "\n"
+    // (--help: the usage alone, on standard output, exit status 0)
+    std::ostream& os = msg.empty() ? std::cout : std::cerr;
+    if (!msg.empty()) os << "mbaBenchmark: " << msg << "\n";
+    os <<
         "usage: mbaBenchmark [--case surface|volume] [--k K] [--n N] [--eval M] [--tolerance T]\n"
         "                    [--max-levels L] [--initial-grid G] [--seed S] [--dim 2|3] [--ranks R]\n"
         "                    [--no-affine] [--method mba|rbf] [--shape C]\n";
-    std::exit(2);
+    std::exit(msg.empty() ? 0 : 2);
 }
 
 options parse(int argc, char** argv)
@@ -60,6 +63,7 @@ options parse(int argc, char** argv)
     for (int i = 1; i < argc; ++i)
     {
         const std::string a = argv[i];
+        if (a == "--help" || a == "-h" || a == "-help") usage("");
         auto val = [&]() -> std::string {
             if (i + 1 >= argc) usage("missing value for " + a);
             return argv[++i];

@@ -69,11 +69,14 @@ struct options
 
 [[noreturn]] void usage(const std::string& msg)
 {
-    std::cerr << "mbaScaling: " << msg << "\n"
+    // (--help: the usage alone, on standard output, exit status 0)
+    std::ostream& os = msg.empty() ? std::cout : std::cerr;
+    if (!msg.empty()) os << "mbaScaling: " << msg << "\n";
+    os <<
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
         "                  [--control owner|balanced]\n";
-    std::exit(2);
+    std::exit(msg.empty() ? 0 : 2);
 }
 
 /// Parts per direction: (P 1 1), the most even a >= b >= c with a b c = P,
@@ -101,6 +104,7 @@ options parse(int argc, char** argv)
     for (int i = 1; i < argc; ++i)
     {
         const std::string a = argv[i];
+        if (a == "--help" || a == "-h" || a == "-help") usage("");
         auto val = [&]() -> std::string {
             if (i + 1 >= argc) usage("missing value for " + a);
             return argv[++i];
