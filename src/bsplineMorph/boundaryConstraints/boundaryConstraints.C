@@ -252,6 +252,11 @@ void Foam::boundaryConstraints::readFixedPatch
       ? static_cast<const vectorField&>(*vpf)
       : vectorField(disp, meshPoints)
     );
+    // An out-of-plane component is worth a warning from 1e-10 of the mesh's
+    // size on (a motion in the plane, e.g. solidBodyMotionDisplacement's
+    // rotation about the empty axis, leaves round-off there)
+    const scalar outOfPlane =
+        directions_.size() < 3 ? 1e-10*pMesh_().bounds().mag() : 0;
     forAll(meshPoints, i)
     {
         const label pointi = meshPoints[i];
@@ -260,7 +265,7 @@ void Foam::boundaryConstraints::readFixedPatch
         for (direction c = 0; c < 3; ++c)
         {
             if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
-            if (solD[c] != 1 && values[i][c] != 0)
+            if (solD[c] != 1 && mag(values[i][c]) > outOfPlane)
             {
                 emptyDirection.insert(pp.name());
             }
