@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write a morphing test case: a unit box with a cube-shaped hole in the middle.
 
-    morphCase.py DIR [--2d] [--n N] [--solver NAME] [--pimple] [--np N]
+    morphCase.py DIR [--2d [--front-back symmetryPlane]] [--n N] [--solver NAME] [--pimple] [--np N]
 
 3D: 26 hex blocks (a 3x3x3 block grid without its centre), N cells per block
 edge. 2D: the 8 blocks around the centre square, one cell thick in z, front
@@ -32,6 +32,8 @@ ap.add_argument("--rotate", type=float, default=None, metavar="DEG",
 ap.add_argument("--rigid-layers", type=float, nargs=2, default=None, metavar=("INNER", "OUTER"),
                 help="rigidLayers with these inner and outer distances")
 ap.add_argument("--layer-patches", default="hole", help="rigidLayers' patches (default: hole)")
+ap.add_argument("--front-back", default="empty", choices=("empty", "symmetryPlane"),
+                help="--2d: the front and back patches' type (symmetryPlane: a 3D slab one cell thick)")
 a = ap.parse_args()
 
 X = [0.0, 0.35, 0.65, 1.0]
@@ -74,8 +76,13 @@ for c in blocks:
             else:
                 patches[["x", "y", "z"][axis] + ("Max" if side else "Min")].append(face(c, axis, side))
     if a.twoD:
-        patches.setdefault("frontAndBack", [])
-        patches["frontAndBack"] += [face(c, 2, 0), face(c, 2, 1)]
+        if a.front_back == "empty":
+            patches.setdefault("frontAndBack", [])
+            patches["frontAndBack"] += [face(c, 2, 0), face(c, 2, 1)]
+        else:
+            # (a symmetry plane is one plane: front and back apart)
+            patches.setdefault("front", []).append(face(c, 2, 0))
+            patches.setdefault("back", []).append(face(c, 2, 1))
 
 if a.merge_sides and not a.twoD:
     patches["sides"] = sum((patches.pop(k) for k in ["xMin", "xMax", "yMin", "yMax"]), [])
@@ -94,7 +101,7 @@ for (i, j, k) in blocks:
          vid(i, j, k+1), vid(i+1, j, k+1), vid(i+1, j+1, k+1), vid(i, j+1, k+1)]
     bm += "hex (%s) (%d %d %d) simpleGrading (1 1 1)\n" % (" ".join(map(str, h)), n, n, 1 if a.twoD else n)
 bm += ");\nedges ();\nboundary (\n"
-ptype = {"frontAndBack": "empty", "hole": "wall"}
+ptype = {"frontAndBack": "empty", "front": a.front_back, "back": a.front_back, "hole": "wall"}
 for name, faces in patches.items():
     if not faces:
         continue
@@ -138,7 +145,8 @@ move = ("(%.17g 0.03 0)" if a.twoD else "(%.17g 0.03 0.015)") % a.move
 bc = {"hole": "type uniformFixedValue; uniformValue table ((0 (0 0 0)) (3 %s));" % move,
       "xMin": "type slip;", "xMax": "type slip;", "yMin": "type slip;", "yMax": "type slip;",
       "zMin": "type fixedValue; value uniform (0 0 0);", "zMax": "type fixedValue; value uniform (0 0 0);",
-      "frontAndBack": "type empty;", "sides": "type slip;"}
+      "frontAndBack": "type empty;", "front": "type symmetryPlane;", "back": "type symmetryPlane;",
+      "sides": "type slip;"}
 if a.rotate is not None:
     bc["hole"] = ("type solidBodyMotionDisplacement; solidBodyMotionFunction rotatingMotion; "
                   "rotatingMotionCoeffs { solidBodyMotionFunction rotatingMotion; origin (0.45 0.5 0.5); "

@@ -518,6 +518,23 @@ void Foam::rigidLayers::addControls
             bc.slide(pointi, footSlide[j]);
         }
     }
+    // Those on patches whose conditions slide them (a wedge or symmetry
+    // plane through the zone) when their foot is prescribed: fixed at the
+    // rigid motion within their own plane. (Those that their conditions fix
+    // keep their value; those of sliding feet, and on patches that neither
+    // fix nor slide, are no control points.)
+    const List<pointConstraint>& slides = bc.slides();
+    for (const label i : patchShell_)
+    {
+        const label pointi = zonePoints_[i];
+        const label j = zoneFoot_[i];
+        if (!fixed[pointi] && slides[pointi].first() > 0 && footFixed[j])
+        {
+            vector r = rigidMotion(j, zoneArm_[i]);
+            slides[pointi].constrainDisplacement(r);
+            bc.fix(pointi, r);
+        }
+    }
     bc.collectControls();
 }
 

@@ -342,9 +342,10 @@ void Foam::rigidLayers::findFeet
 
 void Foam::rigidLayers::findOutermost()
 {
-    // The rigid zone's outermost points off the patches (within
-    // innerDistance, with an edge to a point beyond it): the interpolation's
-    // extra control points
+    // The rigid zone's outermost points (within innerDistance, with an edge
+    // to a point beyond it): the interpolation's extra control points, those
+    // off the patches always, those on patches where addControls() finds
+    // that they may be
     bitSet inner(mesh_.nPoints());
     markRigid(inner);
     // (the edges as the faces' sides: every edge is a side of a face; the
@@ -372,18 +373,26 @@ void Foam::rigidLayers::findOutermost()
             onPatch.set(pp.meshPoints());
         }
     }
-    DynamicList<label> shell, shellPoints;
+    DynamicList<label> shell, shellPoints, patchShell;
     forAll(zonePoints_, i)
     {
         const label pointi = zonePoints_[i];
-        if (inner.test(pointi) && outermost[pointi] && !onPatch.test(pointi))
+        if (inner.test(pointi) && outermost[pointi])
         {
-            shell.append(i);
-            shellPoints.append(pointi);
+            if (onPatch.test(pointi))
+            {
+                patchShell.append(i);
+            }
+            else
+            {
+                shell.append(i);
+                shellPoints.append(pointi);
+            }
         }
     }
     shell_.transfer(shell);
     shellPoints_.transfer(shellPoints);
+    patchShell_.transfer(patchShell);
 
 }
 
@@ -432,7 +441,10 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << " (" << nOwnedGlobal(owned, inner)
         << " within innerDistance " << innerDistance_ << ", "
         << nOwnedGlobal(owned, shellPoints_)
-        << " of them outermost: control points; rotations smoothed over "
+        << " of them outermost: control points, and "
+        << nOwnedGlobal(owned, labelList(UIndirectList<label>(zonePoints_, patchShell_)))
+        << " more on patches, control points where their conditions slide them"
+        << " and their foot is prescribed; rotations smoothed over "
         << nSmooth_ << " rings of faces, in "
         << nSweeps(nSmooth_, smoothCoeffs_)
         << " sweeps)" << endl;
