@@ -92,6 +92,12 @@ namespace Foam
 
             mba::multilevel<D> plan_;
 
+            //- The mesh's size: residuals under 1e-12 of it are round-off
+            const scalar lengthScale_;
+
+            //- Whether a fit that stopped above its threshold was reported
+            bool warned_ = false;
+
         public:
 
             bsplineInterpolator
@@ -101,7 +107,8 @@ namespace Foam
                 const boundaryConstraints& bc,
                 const pointField& points0,
                 const double* evalXyz,
-                const std::size_t nEval
+                const std::size_t nEval,
+                const scalar lengthScale
             )
             :
                 controlXyz_(controlCoordinates(bc, points0)),
@@ -110,7 +117,8 @@ namespace Foam
                     comm, params, D,
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                     bc.mask(), mba::pointsView<D>(evalXyz, nEval)
-                )
+                ),
+                lengthScale_(lengthScale)
             {}
 
             //- Fit the control values, evaluate at the evaluation points
@@ -149,6 +157,18 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
 
     const mba::fitReport& r = plan_.report();
     const word& type = multilevelBSplineMotionSolver::typeName;
+    if (!r.converged && !warned_ && r.maxResidual > 1e-12*lengthScale_)
+    {
+        // (once: the step's log line says it every time)
+        warned_ = true;
+        WarningInFunction
+            << type << ": the fit stopped after " << r.levels << " levels with"
+            << " a max residual of " << r.maxResidual << ", above its threshold "
+            << r.threshold << " (tolerance): the prescribed points still take"
+            << " their values exactly, the interpolated ones may be off by about"
+            << " that much. More levels reach it (maxLevels, at most 30; the log"
+            << " line says 'not reached' while they do not)" << endl;
+    }
     double nodes = 0, bytes = 0, messages = 0;
     label separated = 0, chunked = 0, tree = 0;
     for (const mba::levelStats& s : plan_.stats())
@@ -295,18 +315,19 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
 {
     const label D = bc.directions().size();
     const std::size_t nEval = evalPoints().size();
+    const scalar lengthScale = mesh().bounds().mag();
     std::unique_ptr<boundaryInterpolator> interpolator;
     try
     {
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, lengthScale));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, lengthScale));
         }
         else
         {
