@@ -505,26 +505,32 @@ Foam::boundaryConstraints::boundaryConstraints
 
 void Foam::boundaryConstraints::checkCouplings
 (
-    const polyMesh& mesh,
+    const pointVectorField& pointDisplacement,
     const word& solver
 )
 {
     // (cyclicAMI says it is not coupled(): the class tells)
-    for (const polyPatch& pp : mesh.boundaryMesh())
+    const polyBoundaryMesh& pbm = pointDisplacement.mesh()().boundaryMesh();
+    forAll(pbm, patchi)
     {
+        const polyPatch& pp = pbm[patchi];
         if
         (
             isA<coupledPolyPatch>(pp)
          && !isA<processorPolyPatch>(pp)
          && !isA<cyclicPolyPatch>(pp)
+         && !pointDisplacement.boundaryField()[patchi].fixesValue()
         )
         {
             FatalErrorInFunction
                 << "Patch " << pp.name() << " is a " << pp.type()
-                << " coupling, which " << solver << " does not support: its"
-                << " two sides would move apart. Supported couplings: cyclic"
-                << " (translational or rotational) and processor patches;"
-                << " the mesh is not moved" << exit(FatalError);
+                << " coupling, which " << solver << " does not interpolate:"
+                << " its two sides would move apart. Supported couplings:"
+                << " cyclic (translational or rotational) and processor"
+                << " patches; a " << pp.type() << " whose sides'"
+                << " pointDisplacement conditions prescribe their motion"
+                << " (patchType " << pp.type() << "; type fixedValue; ...)"
+                << " is accepted. The mesh is not moved" << exit(FatalError);
         }
     }
 }

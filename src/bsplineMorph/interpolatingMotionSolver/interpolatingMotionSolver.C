@@ -243,7 +243,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkCouplings(mesh, type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
 }
 
 
@@ -260,7 +260,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkCouplings(mesh, type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
 }
 
 
