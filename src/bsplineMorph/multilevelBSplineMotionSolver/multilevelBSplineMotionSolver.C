@@ -23,6 +23,7 @@ License
 #include "Enum.H"
 #include "clockTime.H"
 
+#include <algorithm>
 #include <cstdio>
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
@@ -92,9 +93,6 @@ namespace Foam
 
             mba::multilevel<D> plan_;
 
-            //- The mesh's size: residuals under 1e-12 of it are round-off
-            const scalar lengthScale_;
-
             //- Whether a fit that stopped above its threshold was reported
             bool warned_ = false;
 
@@ -107,8 +105,7 @@ namespace Foam
                 const boundaryConstraints& bc,
                 const pointField& points0,
                 const double* evalXyz,
-                const std::size_t nEval,
-                const scalar lengthScale
+                const std::size_t nEval
             )
             :
                 controlXyz_(controlCoordinates(bc, points0)),
@@ -117,8 +114,7 @@ namespace Foam
                     comm, params, D,
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                     bc.mask(), mba::pointsView<D>(evalXyz, nEval)
-                ),
-                lengthScale_(lengthScale)
+                )
             {}
 
             //- Fit the control values, evaluate at the evaluation points
@@ -157,7 +153,12 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
 
     const mba::fitReport& r = plan_.report();
     const word& type = multilevelBSplineMotionSolver::typeName;
-    if (!r.converged && !warned_ && r.maxResidual > 1e-12*lengthScale_)
+    // (residuals under 1e-12 of the lattice domain's longest edge are
+    // round-off)
+    const mba::domain<D>& dom = plan_.dom();
+    const scalar domainSize =
+        dom.h0*scalar(*std::max_element(dom.n0.begin(), dom.n0.end()));
+    if (!r.converged && !warned_ && r.maxResidual > 1e-12*domainSize)
     {
         // (once: the step's log line says it every time)
         warned_ = true;
@@ -315,19 +316,18 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
 {
     const label D = bc.directions().size();
     const std::size_t nEval = evalPoints().size();
-    const scalar lengthScale = mesh().bounds().mag();
     std::unique_ptr<boundaryInterpolator> interpolator;
     try
     {
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, lengthScale));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, lengthScale));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
         }
         else
         {

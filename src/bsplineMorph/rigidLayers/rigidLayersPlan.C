@@ -426,19 +426,13 @@ void Foam::rigidLayers::plan(const pointField& points0)
     const wordList patchNames(pbm.names(), patchIDs_);
     // (each point counted once, however many ranks hold it)
     const boolList owned(ownedPoints(mesh_));
-    DynamicList<label> inner(zonePoints_.size());
-    forAll(zonePoints_, i)
-    {
-        if (zoneWeight_[i] == 1)
-        {
-            inner.append(zonePoints_[i]);
-        }
-    }
+    bitSet inner(mesh_.nPoints());
+    markRigid(inner);
     Info<< "rigidLayers: " << nOwnedGlobal(owned, zonePoints_)
         << " points within outerDistance " << outerDistance_ << " of "
         << nOwnedGlobal(owned, wallPoints_) << " wall points on patches "
         << flatOutput(patchNames)
-        << " (" << nOwnedGlobal(owned, inner)
+        << " (" << nOwnedGlobal(owned, inner.toc())
         << " within innerDistance " << innerDistance_ << ", "
         << nOwnedGlobal(owned, shellPoints_)
         << " of them outermost: control points, and "
