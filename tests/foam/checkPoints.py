@@ -16,6 +16,12 @@
     checkPoints.py tiltedSlip CASE           the sheared block of tests/foam/Alltest.d/tiltedSlip at
                                              time 1: the walls' points on their tilted planes, the
                                              first cell layer following the wall, the pushed face
+    checkPoints.py wedge WEDGE TIME [PLANAR] an axisymmetric case about the x axis (tests/foam/Alltest.d/
+                                             wedge): no point moves across its meridian plane (those on
+                                             the axis move along it), and, given its planar twin (y as
+                                             the radius, empty z), each moves along x and its radius as
+                                             the twin's point at the same (x, r) moves along x and y
+                                             (1e-12 of the domain)
 
 Exit status 1 on any failed check; prints what it measured. Other test
 scripts import check and failures from it (tests/foam/checkMorphQuality.py).
@@ -98,6 +104,44 @@ def tiltedSlip(case):
     moved = max(abs(b[0] - a[0]) for a, b in zip(p0, p1))
     check(abs(moved - 0.1) < 1e-12, "the left face moved 0.1 (largest x displacement %.3g)" % moved)
 
+def wedge(wedgeCase, time, planarCase=None):
+    """Axisymmetric (about the x axis), and against planar: see the module's doc"""
+    import math
+    w0, w1 = pointsAt(wedgeCase, "constant"), pointsAt(wedgeCase, time)
+    size = max(max(p[d] for p in w0) - min(p[d] for p in w0) for d in range(3))
+    key = lambda x, r: (round(x, 8), round(r, 8))
+    if planarCase:
+        q0, q1 = pointsAt(planarCase, "constant"), pointsAt(planarCase, time)
+        planar = {key(p[0], p[1]): i for i, p in enumerate(q0)}
+    across = diff = radial = 0.0
+    matched = onAxis = 0
+    for a, b in zip(w0, w1):
+        r0 = math.hypot(a[1], a[2])
+        d = [b[k] - a[k] for k in range(3)]
+        if r0 > 1e-9:
+            er = (0.0, a[1]/r0, a[2]/r0)
+            et = (0.0, -a[2]/r0, a[1]/r0)
+            across = max(across, abs(sum(d[k]*et[k] for k in range(3))))
+            dr = sum(d[k]*er[k] for k in range(3))
+        else:
+            onAxis += 1
+            across = max(across, math.hypot(d[1], d[2]))
+            dr = 0.0
+        radial = max(radial, abs(dr))
+        if planarCase:
+            j = planar.get(key(a[0], r0))
+            if j is not None:
+                matched += 1
+                e = [q1[j][k] - q0[j][k] for k in range(2)]
+                diff = max(diff, abs(d[0] - e[0]), abs(dr - e[1]))
+    check(across <= 1e-12*size, "no point moves across its meridian plane, the %d on the axis move along "
+          "it (largest departure %.2e, domain %.3g)" % (onAxis, across, size))
+    check(radial > 1e-3, "the points moved radially (largest %.3g), the check is not vacuous" % radial)
+    if planarCase:
+        check(matched == len(w0), "every point has a planar twin at its (x, r) (%d of %d)" % (matched, len(w0)))
+        check(diff <= 1e-12*size, "each moves along x and its radius as its planar twin does: largest "
+              "difference %.2e <= 1e-12 x %.3g" % (diff, size))
+
 def main():
     mode = sys.argv[1]
     if mode == "equal":
@@ -162,6 +206,8 @@ def main():
         cyclicPairs(sys.argv[2], sys.argv[3])
     elif mode == "tiltedSlip":
         tiltedSlip(sys.argv[2])
+    elif mode == "wedge":
+        wedge(*sys.argv[2:5])
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv

@@ -103,17 +103,16 @@ Foam::rbfInterpolator<D>::rbfInterpolator
     controlXyz_(D),
     eval_(evalXyz, nEval)
 {
-    const labelList& dirs = bc.directions();
     forAll(bc.controlPoints(), i)
     {
         for (label k = 0; k < D; ++k)
         {
             if (!bc.mask()[i*D + k]) continue;
             selected_[k].push_back(i);
-            for (const label d : dirs)
-            {
-                controlXyz_[k].push_back(points0[bc.controlPoints()[i]][d]);
-            }
+            bc.frame().appendCoordinates
+            (
+                points0[bc.controlPoints()[i]], controlXyz_[k]
+            );
         }
     }
     for (label k = 0; k < D; ++k)
@@ -241,7 +240,7 @@ Foam::RBFMotionSolver::newInterpolator
     const bool refit
 )
 {
-    const label D = bc.directions().size();
+    const label D = bc.frame().size();
     const std::size_t nEval = evalPoints().size();
     const clockTime timer;
     std::unique_ptr<boundaryInterpolator> interpolator;

@@ -59,36 +59,6 @@ namespace
 
 // * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
-bool Foam::boundaryConstraints::axisMask(const pointConstraint& pc, bool mask[3])
-{
-    const scalar tol = 1e-9;
-    mask[0] = mask[1] = mask[2] = false;
-    if (pc.first() == 3)
-    {
-        mask[0] = mask[1] = mask[2] = true;
-        return true;
-    }
-    // plane: the normal; line: the free direction
-    const vector& v = pc.second();
-    for (direction d = 0; d < 3; ++d)
-    {
-        if (mag(v[d]) >= 1 - tol)
-        {
-            if (pc.first() == 1)
-            {
-                mask[d] = true;
-            }
-            else
-            {
-                mask[(d + 1) % 3] = mask[(d + 2) % 3] = true;
-            }
-            return true;
-        }
-    }
-    return false;
-}
-
-
 // * * * * * * * * * * * * * * * Global Functions  * * * * * * * * * * * * * //
 
 Foam::boolList Foam::ownedPoints(const polyMesh& mesh)
@@ -138,22 +108,15 @@ Foam::label Foam::nOwnedGlobal(const boolList& owned)
 
 Foam::boundaryConstraints::boundaryConstraints
 (
-    const pointVectorField& pointDisplacement
+    const pointVectorField& pointDisplacement,
+    const pointField& points0
 )
 :
     pMesh_(pointDisplacement.mesh()),
+    frame_(std::make_shared<const solutionFrame>(pMesh_(), points0)),
     nCyclicGlobal_(0)
 {
     const polyMesh& mesh = pMesh_();
-    const Vector<label>& solD = mesh.solutionD();
-    for (direction d = 0; d < 3; ++d)
-    {
-        if (solD[d] == 1)
-        {
-            directions_.append(d);
-        }
-    }
-
     owned_ = ownedPoints(mesh);
 
     // The points of every patch but empty ones, and of those whose
@@ -172,6 +135,8 @@ Foam::boundaryConstraints::boundaryConstraints
             }
         }
     }
+    // (and the points on an axisymmetric mesh's axis, which slide along it)
+    onPatch.set(frame_->axisPoints());
     boundaryPoints_ = onPatch.sortedToc();
     conditionPoints_ =
         std::make_shared<const sharedPoints>(mesh, onAnyRank(mesh, onCondition));
@@ -242,7 +207,7 @@ void Foam::boundaryConstraints::readFixedPatch
 {
     const pointPatch& pp = pf.patch();
     const labelList& meshPoints = pp.meshPoints();
-    const Vector<label>& solD = pMesh_().solutionD();
+    const solutionFrame& frame = *frame_;
     // The condition's own values (the internal field at a point on a fixed
     // and a slip patch depends on their evaluation order)
     const valuePointPatchVectorField* vpf = isA<valuePointPatchVectorField>(pf);
@@ -255,8 +220,8 @@ void Foam::boundaryConstraints::readFixedPatch
     // An out-of-plane component is worth a warning from 1e-10 of the mesh's
     // size on (a motion in the plane, e.g. solidBodyMotionDisplacement's
     // rotation about the empty axis, leaves round-off there)
-    const scalar outOfPlane =
-        directions_.size() < 3 ? 1e-10*pMesh_().bounds().mag() : 0;
+    const bool twoD = frame.size() < 3;
+    const scalar outOfPlane = 1e-10*pMesh_().bounds().mag();
     forAll(meshPoints, i)
     {
         const label pointi = meshPoints[i];
@@ -265,10 +230,14 @@ void Foam::boundaryConstraints::readFixedPatch
         for (direction c = 0; c < 3; ++c)
         {
             if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
-            if (solD[c] != 1 && mag(values[i][c]) > outOfPlane)
-            {
-                emptyDirection.insert(pp.name());
-            }
+        }
+        if
+        (
+            twoD
+         && mag(values[i] - frame.inFrame(pointi, values[i])) > outOfPlane
+        )
+        {
+            emptyDirection.insert(pp.name());
         }
     }
 }
@@ -278,6 +247,22 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
 {
     const pointPatch& pp = pf.patch();
     const labelList& meshPoints = pp.meshPoints();
+    const solutionFrame& frame = *frame_;
+    if (frame.axisymmetric() && pp.constraintType() == "wedge")
+    {
+        // The frame keeps every point in its meridian plane
+        return;
+    }
+    // A plane's normal as the frame sees it at a point (zero: the plane
+    // holds nothing in the frame)
+    auto applyNormal = [&](const label pointi, const vector& n)
+    {
+        const vector m = frame.planeNormal(pointi, n);
+        if (m != vector::zero)
+        {
+            slide_[pointi].applyConstraint(m);
+        }
+    };
     if (pf.type() == "slip" || pp.constraintType() == "symmetry")
     {
         // Each face's own normal on each of its points, combined (plane,
@@ -292,7 +277,7 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         {
             for (const label lp : lf[facei])
             {
-                slide_[meshPoints[lp]].applyConstraint(nf[facei]);
+                applyNormal(meshPoints[lp], nf[facei]);
             }
         }
     }
@@ -306,7 +291,7 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         n /= mag(n) + VSMALL;
         for (const label pointi : meshPoints)
         {
-            slide_[pointi].applyConstraint(n);
+            applyNormal(pointi, n);
         }
     }
     else if (pp.constraintType() != word::null)
@@ -316,7 +301,14 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         {
             pointConstraint pc;
             pp.applyConstraint(i, pc);
-            slide_[meshPoints[i]].combine(pc);
+            if (frame.axisymmetric() && pc.first() == 1)
+            {
+                applyNormal(meshPoints[i], pc.second());
+            }
+            else
+            {
+                slide_[meshPoints[i]].combine(pc);
+            }
         }
     }
 }
@@ -346,7 +338,7 @@ void Foam::boundaryConstraints::checkPrescribed
     // A 2D case moves in its plane: a prescribed component out of it is
     // dropped, with a warning (once per patch; a 3D case has none to
     // gather, on any rank)
-    if (directions_.size() == 3)
+    if (frame_->size() == 3)
     {
         return;
     }
@@ -360,12 +352,25 @@ void Foam::boundaryConstraints::checkPrescribed
         {
             names<< ' ' << name;
         }
-        WarningInFunction
-            << "pointDisplacement prescribes a non-zero displacement in the"
-            << " empty direction of this 2D case on patches:"
-            << names.str().c_str() << ", at time "
-            << mesh.time().timeName() << ": that component is dropped (the"
-            << " mesh moves in its plane only)" << endl;
+        if (frame_->axisymmetric())
+        {
+            WarningInFunction
+                << "pointDisplacement prescribes a non-zero displacement"
+                << " across the meridian planes (around the axis) of this"
+                << " axisymmetric (wedge) case on patches:"
+                << names.str().c_str() << ", at time "
+                << mesh.time().timeName() << ": that component is dropped"
+                << " (the mesh moves along its axis and radii only)" << endl;
+        }
+        else
+        {
+            WarningInFunction
+                << "pointDisplacement prescribes a non-zero displacement in"
+                << " the empty direction of this 2D case on patches:"
+                << names.str().c_str() << ", at time "
+                << mesh.time().timeName() << ": that component is dropped"
+                << " (the mesh moves in its plane only)" << endl;
+        }
         warnedEmptyDirection_ += emptyDirection;
     }
 }
@@ -396,6 +401,19 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     }
     checkPrescribed(nonFinite, emptyDirection);
 
+    // The points on an axisymmetric mesh's axis slide along it
+    if (frame_->axisymmetric())
+    {
+        const pointConstraint alongAxis
+        (
+            Tuple2<label, vector>(2, frame_->axis())
+        );
+        for (const label pointi : frame_->axisPoints())
+        {
+            slide_[pointi].combine(alongAxis);
+        }
+    }
+
     // The same view of every processor-shared point on all its ranks (the
     // conditions set values at their patches' points only)
     conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
@@ -412,8 +430,9 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
 
 void Foam::boundaryConstraints::collectControls()
 {
-    // Control points in the solution directions
-    const label nd = directions_.size();
+    // Control points in the frame's directions
+    const solutionFrame& frame = *frame_;
+    const label nd = frame.size();
     DynamicList<label> ctrl, proj;
     mask_.clear();
     values_.clear();
@@ -426,27 +445,28 @@ void Foam::boundaryConstraints::collectControls()
         }
         else if (slide_[pointi].first() > 0)
         {
-            if (!axisMask(slide_[pointi], m))
+            if (!frame.mask(pointi, slide_[pointi], m))
             {
                 proj.append(pointi);
                 continue;
             }
         }
         bool any = false;
-        for (const label d : directions_)
+        for (label k = 0; k < nd; ++k)
         {
-            any = any || m[d];
+            any = any || m[k];
         }
         if (!any || !owned_[pointi])
         {
             continue;
         }
         ctrl.append(pointi);
+        vector b[3];
+        frame.basis(pointi, b);
         for (label k = 0; k < nd; ++k)
         {
-            const direction d = directions_[k];
-            mask_.push_back(m[d]);
-            values_.push_back(fixed_[pointi] ? value_[pointi][d] : 0.0);
+            mask_.push_back(m[k]);
+            values_.push_back(fixed_[pointi] ? (b[k] & value_[pointi]) : 0.0);
         }
     }
     controlPoints_.transfer(ctrl);
@@ -476,7 +496,7 @@ Foam::boundaryConstraints::boundaryConstraints
 )
 :
     pMesh_(bc.pMesh_),
-    directions_(bc.directions_),
+    frame_(bc.frame_),
     fixed_(bc.fixed_),
     value_(bc.value_),
     slide_(bc.slide_),
@@ -629,6 +649,7 @@ Foam::label Foam::boundaryConstraints::nRefitGlobal() const
 
 void Foam::boundaryConstraints::constrain(vectorField& displacement) const
 {
+    const solutionFrame& frame = *frame_;
     for (const label pointi : boundaryPoints_)
     {
         vector& d = displacement[pointi];
@@ -638,12 +659,16 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
         }
         else if (slide_[pointi].first() > 0)
         {
+            // (a constraint along the frame's directions removes exactly
+            // those components: along an axis, exactly zero)
             bool m[3];
-            if (axisMask(slide_[pointi], m))
+            if (frame.mask(pointi, slide_[pointi], m))
             {
-                for (direction c = 0; c < 3; ++c)
+                vector b[3];
+                frame.basis(pointi, b);
+                for (label k = 0; k < frame.size(); ++k)
                 {
-                    if (m[c]) d[c] = 0;
+                    if (m[k]) d -= (b[k] & d)*b[k];
                 }
             }
             else
@@ -652,13 +677,9 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
             }
         }
     }
-    const Vector<label>& solD = pMesh_().solutionD();
-    for (direction c = 0; c < 3; ++c)
+    if (frame_->size() < 3)
     {
-        if (solD[c] != 1)
-        {
-            displacement.replace(c, scalar(0));
-        }
+        frame_->constrain(displacement);
     }
 }
 

@@ -142,13 +142,13 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
         return;
     }
     evalPoints_.transfer(points);
-    const labelList& dirs = constraintsPtr_->directions();
+    const solutionFrame& frame = constraintsPtr_->frame();
     const pointField& p0 = points0();
     evalXyz_.clear();
-    evalXyz_.reserve(dirs.size()*evalPoints_.size());
+    evalXyz_.reserve(frame.size()*evalPoints_.size());
     for (const label pointi : evalPoints_)
     {
-        for (const label d : dirs) evalXyz_.push_back(p0[pointi][d]);
+        frame.appendCoordinates(p0[pointi], evalXyz_);
     }
     // The re-fit interpolator evaluates these points too
     refitInterpolatorPtr_.reset();
@@ -165,17 +165,32 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateInto
     const interpolationReport report = interpolator.interpolate(bc, values_);
     // The interpolated points' displacement (zero outside the solution
     // directions) and their moved points, in one pass
+    const solutionFrame& frame = constraintsPtr_->frame();
+    const pointField& p0 = points0();
+    const double* v = values_.data();
+    if (frame.axisymmetric())
+    {
+        forAll(evalPoints_, i)
+        {
+            const label pointi = evalPoints_[i];
+            vector b[3];
+            frame.basis(pointi, b);
+            const vector d(v[0]*b[0] + v[1]*b[1]);
+            v += 2;
+            displacement[pointi] = d;
+            newPoints_[pointi] = p0[pointi] + d;
+        }
+        return report;
+    }
     // (each component read from its packed value or zero, into registers:
     // a vector filled through d[dirs[k]] stalls every point on its stores)
-    const labelList& dirs = constraintsPtr_->directions();
+    const labelList& dirs = frame.directions();
     const label nd = dirs.size();
     label at[3] = {-1, -1, -1};         // packed position of each direction
     forAll(dirs, k)
     {
         at[dirs[k]] = k;
     }
-    const pointField& p0 = points0();
-    const double* v = values_.data();
     forAll(evalPoints_, i)
     {
         const label pointi = evalPoints_[i];
@@ -298,7 +313,10 @@ bool Foam::interpolatingMotionSolver::updateControls()
     std::vector<std::uint8_t> mask;
     if (first)
     {
-        constraintsPtr_.reset(new boundaryConstraints(pointDisplacement_));
+        constraintsPtr_.reset
+        (
+            new boundaryConstraints(pointDisplacement_, points0())
+        );
     }
     else
     {
@@ -367,7 +385,7 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
         (
             points0(),
             bc.fixed(),
-            bc.directions(),
+            bc.frame(),
             displacement,
             newPoints_
         );

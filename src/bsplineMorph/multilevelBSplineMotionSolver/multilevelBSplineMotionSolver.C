@@ -72,10 +72,10 @@ namespace Foam
         )
         {
             std::vector<double> xyz;
-            xyz.reserve(bc.directions().size()*bc.controlPoints().size());
+            xyz.reserve(bc.frame().size()*bc.controlPoints().size());
             for (const label pointi : bc.controlPoints())
             {
-                for (const label d : bc.directions()) xyz.push_back(points0[pointi][d]);
+                bc.frame().appendCoordinates(points0[pointi], xyz);
             }
             return xyz;
         }
@@ -314,7 +314,7 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
     const bool refit
 )
 {
-    const label D = bc.directions().size();
+    const label D = bc.frame().size();
     const std::size_t nEval = evalPoints().size();
     std::unique_ptr<boundaryInterpolator> interpolator;
     try
@@ -346,7 +346,8 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
     Info<< type() << ": " << (refit ? "re-fit " : "") << "plan for "
         << nControl << " control points, "
         << nOwnedGlobal(bc.owned()) << " mesh points ("
-        << nOwnedGlobal(bc.owned(), evalPoints()) << " interpolated), " << D << "D";
+        << nOwnedGlobal(bc.owned(), evalPoints()) << " interpolated), "
+        << bc.frame().name();
     if (Pstream::parRun())
     {
         // The fit's work is per control point: how evenly the ranks hold them

@@ -481,10 +481,10 @@ void Foam::rigidLayers::addControls
     const boolList& fixed = bc.fixed();
     const vectorField& prescribed = bc.prescribed();
     fitRotations(points0, prescribed, &fixed);
-    // Walls all of whose points are prescribed (in 3D: in 2D the empty
-    // direction of a prescribed value is zeroed later) have these transforms
+    // Walls all of whose points are prescribed (in 3D: in 2D the part of a
+    // prescribed value across the frame is dropped later) have these transforms
     // after the fit too: apply() keeps them
-    bool allFixed = mesh_.nSolutionD() == 3;
+    bool allFixed = bc.frame().size() == 3;
     for (const label pointi : wallPoints_)
     {
         allFixed = allFixed && fixed[pointi];
@@ -543,7 +543,7 @@ void Foam::rigidLayers::apply
 (
     const pointField& points0,
     const boolList& fixed,
-    const labelList& dirs,
+    const solutionFrame& frame,
     vectorField& displacement,
     pointField& newPoints
 )
@@ -560,11 +560,6 @@ void Foam::rigidLayers::apply
         mapPtr_->distribute(footDisplacement_);
     }
 
-    bool solved[3] = {false, false, false};
-    for (const label d : dirs)
-    {
-        solved[d] = true;
-    }
     forAll(zonePoints_, i)
     {
         const label pointi = zonePoints_[i];
@@ -581,10 +576,7 @@ void Foam::rigidLayers::apply
         {
             rigid = d + w*(rigid - d);
         }
-        for (direction c = 0; c < 3; ++c)
-        {
-            d[c] = solved[c] ? rigid[c] : 0;
-        }
+        d = frame.inFrame(pointi, rigid);
         newPoints[pointi] = points0[pointi] + d;
     }
 }

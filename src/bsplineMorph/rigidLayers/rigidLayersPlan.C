@@ -18,6 +18,7 @@ License
 #include "rigidLayers.H"
 #include "boundaryConstraints.H"
 #include "emptyPolyPatch.H"
+#include "wedgePolyPatch.H"
 #include "syncTools.H"
 #include "globalIndex.H"
 #include "bitSet.H"
@@ -345,7 +346,8 @@ void Foam::rigidLayers::findOutermost()
     // The rigid zone's outermost points (within innerDistance, with an edge
     // to a point beyond it): the interpolation's extra control points, those
     // off the patches always, those on patches where addControls() finds
-    // that they may be
+    // that they may be (an axisymmetric mesh's wedge planes are no such
+    // patches: its frame keeps their points on them)
     bitSet inner(mesh_.nPoints());
     markRigid(inner);
     // (the edges as the faces' sides: every edge is a side of a face; the
@@ -368,7 +370,12 @@ void Foam::rigidLayers::findOutermost()
     bitSet onPatch(mesh_.nPoints());
     for (const polyPatch& pp : mesh_.boundaryMesh())
     {
-        if (!pp.coupled() && !isA<emptyPolyPatch>(pp))
+        if
+        (
+            !pp.coupled()
+         && !isA<emptyPolyPatch>(pp)
+         && !isA<wedgePolyPatch>(pp)
+        )
         {
             onPatch.set(pp.meshPoints());
         }
