@@ -133,7 +133,9 @@ namespace
     // of the mesh moved to them (its cell centres and volumes), its cell
     // volumes below VSMALL and the face pyramids against its centres below
     // -SMALL that checkCellVolumes and checkFacePyramids report (each
-    // pyramid on its own side); the number of cells with either (all ranks)
+    // pyramid on its own side), and those below -1e-10 of their scale
+    // |S| |h| / 3 (invertedCellCheck::turnedFraction: a face turned in a
+    // cell too small for SMALL); the number of cells with any (all ranks)
     label checkMeshInvalidCells(const polyMesh& mesh, const pointField& p)
     {
         polyMesh copy
@@ -152,14 +154,22 @@ namespace
             invalid[celli] = copy.cellVolumes()[celli] < VSMALL;
         }
         scalarField ownPyrVol, neiPyrVol;
-        primitiveMeshTools::facePyramidVolume(copy, p, copy.cellCentres(), ownPyrVol, neiPyrVol);
+        const vectorField& cc = copy.cellCentres();
+        primitiveMeshTools::facePyramidVolume(copy, p, cc, ownPyrVol, neiPyrVol);
+        const vectorField& S = copy.faceAreas();
+        const vectorField& fc = copy.faceCentres();
+        const scalar eps = invertedCellCheck::turnedFraction/3;
         forAll(ownPyrVol, facei)
         {
-            if (ownPyrVol[facei] < -SMALL) invalid[mesh.faceOwner()[facei]] = true;
+            const label o = mesh.faceOwner()[facei];
+            const scalar scale = eps*mag(S[facei])*mag(cc[o] - fc[facei]);
+            if (ownPyrVol[facei] < -SMALL || ownPyrVol[facei] < -scale) invalid[o] = true;
         }
         forAll(neiPyrVol, facei)
         {
-            if (neiPyrVol[facei] < -SMALL) invalid[mesh.faceNeighbour()[facei]] = true;
+            const label n = mesh.faceNeighbour()[facei];
+            const scalar scale = eps*mag(S[facei])*mag(cc[n] - fc[facei]);
+            if (neiPyrVol[facei] < -SMALL || neiPyrVol[facei] < -scale) invalid[n] = true;
         }
         return returnReduce(label(std::count(invalid.begin(), invalid.end(), true)), sumOp<label>());
     }
@@ -260,7 +270,7 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
         // fraction of a cell's diagonal (0.1 x 0.125 x 0.1667): its eight
         // cells fold before any turns inside out
         const vector h(0.1, 0.125, 1.0/6);
-        label foldedOnly = 0;
+        label foldedOnly = 0, shrunkFolded = 0;
         for (const scalar s : {0.1, 0.3, 0.5, 0.7, 0.9, 1.2})
         {
             pointField p(p0);
@@ -290,10 +300,21 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
                 CHECK(mag(r.where.max() - (point(0.3, 0.5, 0.5) + s*h)) < mag(h));
                 CHECK(mag(r.where.min() - (point(0.3, 0.5, 0.5) + s*h)) < mag(h));
             }
+            // The same mesh 1e5 times smaller (cells of 2e-18 m^3, whose
+            // pyramids are all within checkMesh's absolute SMALL): the same
+            // cells fold
+            const pointField small(1e-5*p);
+            const invertedCellCheck::result rSmall = check.check(small);
+            CHECK(rSmall.nInvalid == r.nInvalid);
+            CHECK(rSmall.nFolded == r.nFolded);
+            CHECK(rSmall.nInvalid == checkMeshInvalidCells(mesh, small));
+            if (r.nFolded > 0 && r.nNonPositive == 0) shrunkFolded += rSmall.nFolded;
         }
         // Some pushes fold cells that keep a positive volume: the check
-        // that looked at volumes only let these through
+        // that looked at volumes only let these through; and also in the
+        // shrunk mesh, where only the pyramids' own scale tells
         CHECK(foldedOnly > 0);
+        CHECK(shrunkFolded > 0);
     }
 }
 

@@ -595,11 +595,16 @@ Foam::label Foam::invertedCellCheck::checkMeshVerdict
     }
     for (const label facei : cellFaces)
     {
-        // pyramidPointFaceRef(face, centre).mag(points), negated for the owner
+        // pyramidPointFaceRef(face, centre).mag(points), negated for the
+        // owner: an error below -SMALL, as checkMesh's pyramids, or below
+        // -turnedFraction of its own scale |S| |h| / 3 (a face turned
+        // against the cell in a cell too small for the absolute SMALL:
+        // checkMesh counts the face as a non-orthogonality error)
         const face& f = faces[facei];
-        const scalar pyrVol =
-            (1.0/3.0)*(f.areaNormal(points) & (centre - f.centre(points)));
-        if ((own[facei] == celli ? -pyrVol : pyrVol) < -SMALL)
+        const vector S = f.areaNormal(points);
+        const vector h = centre - f.centre(points);
+        const scalar pyrVol = (1.0/3.0)*(own[facei] == celli ? -(S & h) : (S & h));
+        if (pyrVol < -SMALL || pyrVol < -turnedFraction*(1.0/3.0)*mag(S)*mag(h))
         {
             return 2;
         }
