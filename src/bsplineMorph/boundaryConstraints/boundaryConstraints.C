@@ -299,9 +299,11 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         // symmetryPlane, wedge, cyclicSlip: the patch's own constraint
         forAll(meshPoints, i)
         {
+            // (a plane: its normal as the frame sees it, as the slip
+            // patches' above)
             pointConstraint pc;
             pp.applyConstraint(i, pc);
-            if (frame.axisymmetric() && pc.first() == 1)
+            if (pc.first() == 1)
             {
                 applyNormal(meshPoints[i], pc.second());
             }
@@ -352,25 +354,20 @@ void Foam::boundaryConstraints::checkPrescribed
         {
             names<< ' ' << name;
         }
-        if (frame_->axisymmetric())
-        {
-            WarningInFunction
-                << "pointDisplacement prescribes a non-zero displacement"
-                << " across the meridian planes (around the axis) of this"
-                << " axisymmetric (wedge) case on patches:"
-                << names.str().c_str() << ", at time "
-                << mesh.time().timeName() << ": that component is dropped"
-                << " (the mesh moves along its axis and radii only)" << endl;
-        }
-        else
-        {
-            WarningInFunction
-                << "pointDisplacement prescribes a non-zero displacement in"
-                << " the empty direction of this 2D case on patches:"
-                << names.str().c_str() << ", at time "
-                << mesh.time().timeName() << ": that component is dropped"
-                << " (the mesh moves in its plane only)" << endl;
-        }
+        const bool axisymmetric = frame_->axisymmetric();
+        WarningInFunction
+            << "pointDisplacement prescribes a non-zero displacement"
+            << (
+                   axisymmetric
+                 ? " across the meridian planes (around the axis) of this"
+                   " axisymmetric (wedge) case"
+                 : " in the empty direction of this 2D case"
+               )
+            << " on patches:" << names.str().c_str() << ", at time "
+            << mesh.time().timeName() << ": that component is dropped (the"
+            << " mesh moves "
+            << (axisymmetric ? "along its axis and radii" : "in its plane")
+            << " only)" << endl;
         warnedEmptyDirection_ += emptyDirection;
     }
 }
