@@ -16,12 +16,21 @@
     checkPoints.py tiltedSlip CASE           the sheared block of tests/foam/Alltest.d/tiltedSlip at
                                              time 1: the walls' points on their tilted planes, the
                                              first cell layer following the wall, the pushed face
-    checkPoints.py wedge WEDGE TIME [PLANAR] an axisymmetric case about the x axis (tests/foam/Alltest.d/
+    checkPoints.py wedge WEDGE TIME [PLANAR] [--tol T] [--axial]
+                                             an axisymmetric case about the x axis (tests/foam/Alltest.d/
                                              wedge): no point moves across its meridian plane (those on
                                              the axis move along it), and, given its planar twin (y as
                                              the radius, empty z), each moves along x and its radius as
                                              the twin's point at the same (x, r) moves along x and y
-                                             (1e-12 of the domain)
+                                             (T of the domain, default 1e-12); --axial: a case whose
+                                             conditions move everything along the axis (movingCone):
+                                             no point moves radially either
+    checkPoints.py coneLayers CASE TIME INNER [PLAIN] [--tol T]
+                                             OpenFOAM's movingCone (tests/foam/Alltest.d/movingCone), its
+                                             cone moved by (TIME 0 0): every point within INNER of one of
+                                             the cone's points moved by exactly that (T of the domain,
+                                             default 1e-12); in PLAIN (the same run without rigidLayers)
+                                             they do not
 
 Exit status 1 on any failed check; prints what it measured. Other test
 scripts import check and failures from it (tests/foam/checkMorphQuality.py).
@@ -104,7 +113,7 @@ def tiltedSlip(case):
     moved = max(abs(b[0] - a[0]) for a, b in zip(p0, p1))
     check(abs(moved - 0.1) < 1e-12, "the left face moved 0.1 (largest x displacement %.3g)" % moved)
 
-def wedge(wedgeCase, time, planarCase=None):
+def wedge(wedgeCase, time, planarCase=None, tol=1e-12, axial=False):
     """Axisymmetric (about the x axis), and against planar: see the module's doc"""
     import math
     w0, w1 = pointsAt(wedgeCase, "constant"), pointsAt(wedgeCase, time)
@@ -134,13 +143,45 @@ def wedge(wedgeCase, time, planarCase=None):
                 matched += 1
                 e = [q1[j][k] - q0[j][k] for k in range(2)]
                 diff = max(diff, abs(d[0] - e[0]), abs(dr - e[1]))
-    check(across <= 1e-12*size, "no point moves across its meridian plane, the %d on the axis move along "
-          "it (largest departure %.2e, domain %.3g)" % (onAxis, across, size))
-    check(radial > 1e-3, "the points moved radially (largest %.3g), the check is not vacuous" % radial)
+    check(across <= tol*size, "no point moves across its meridian plane, the %d on the axis move along "
+          "it (largest departure %.2e <= %g x domain %.3g)" % (onAxis, across, tol, size))
+    if axial:
+        moved = max(abs(b[0] - a[0]) for a, b in zip(w0, w1))
+        check(radial <= tol*size and moved > 1e-3*size, "every point moves along the axis only (largest "
+              "radial part %.2e, largest axial %.3g)" % (radial, moved))
+    else:
+        check(radial > 1e-3*size, "the points moved radially (largest %.3g), the check is not vacuous" % radial)
     if planarCase:
         check(matched == len(w0), "every point has a planar twin at its (x, r) (%d of %d)" % (matched, len(w0)))
-        check(diff <= 1e-12*size, "each moves along x and its radius as its planar twin does: largest "
-              "difference %.2e <= 1e-12 x %.3g" % (diff, size))
+        check(diff <= tol*size, "each moves along x and its radius as its planar twin does: largest "
+              "difference %.2e <= %g x %.3g" % (diff, tol, size))
+
+def coneLayers(case, time, inner, plain=None, tol=1e-12):
+    """movingCone's rigid zone moved with the cone: see the module's doc"""
+    import numpy as np
+    p0, p1 = np.array(pointsAt(case, "constant")), np.array(pointsAt(case, time))
+    size = (p0.max(axis=0) - p0.min(axis=0)).max()
+    x, r = p0[:, 0], np.hypot(p0[:, 1], p0[:, 2])
+    # the cone (movingWall) in the meridian plane, in metres: x = -7 mm for
+    # r up to 0.75, the slant to (-3.5, 2), and x = -3.5 mm down to the axis
+    e = 1e-9
+    cone = ((np.abs(x + 0.007) < e) & (r < 0.00075 + e)) \
+        | ((np.abs(x + 0.0035) < e) & (r < 0.002 + e)) \
+        | ((x > -0.007 - e) & (x < -0.0035 + e)
+           & (np.abs((r - 0.00075)*3.5 - (x + 0.007)*1.25) < e))
+    move = np.array([float(time), 0.0, 0.0])
+    dist = np.sqrt(((p0[:, None, :] - p0[cone][None, :, :])**2).sum(axis=2)).min(axis=1)
+    zone = (dist < inner) & ~cone
+    err = np.abs(p1 - p0 - move).max(axis=1)
+    check(cone.sum() > 0 and err[cone].max() <= tol*size, "the cone's %d points moved by %s (largest "
+          "error %.2e <= %g x %.3g)" % (cone.sum(), move, err[cone].max(), tol, size))
+    check(zone.sum() > 0 and err[zone].max() <= tol*size,
+          "the %d points within %g of them moved with the cone: largest error %.2e <= %g x %.3g"
+          % (zone.sum(), inner, err[zone].max(), tol, size))
+    if plain:
+        q1 = np.array(pointsAt(plain, time))
+        off = np.abs(q1 - p0 - move).max(axis=1)[zone].max()
+        check(off > 1e-3*size, "without rigidLayers they do not (largest departure %.3g)" % off)
 
 def main():
     mode = sys.argv[1]
@@ -207,7 +248,13 @@ def main():
     elif mode == "tiltedSlip":
         tiltedSlip(sys.argv[2])
     elif mode == "wedge":
-        wedge(*sys.argv[2:5])
+        args = [a for i, a in enumerate(sys.argv[2:], 2) if not a.startswith("--") and sys.argv[i - 1] != "--tol"]
+        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        wedge(*args[:3], tol=tol, axial="--axial" in sys.argv)
+    elif mode == "coneLayers":
+        args = [a for i, a in enumerate(sys.argv[2:], 2) if not a.startswith("--") and sys.argv[i - 1] != "--tol"]
+        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        coneLayers(args[0], args[1], float(args[2]), *args[3:4], tol=tol)
     else:
         case, time = sys.argv[2:4]
         twoD = "--2d" in sys.argv

@@ -217,9 +217,11 @@ void Foam::boundaryConstraints::readFixedPatch
       ? static_cast<const vectorField&>(*vpf)
       : vectorField(disp, meshPoints)
     );
-    // An out-of-plane component is worth a warning from 1e-10 of the mesh's
-    // size on (a motion in the plane, e.g. solidBodyMotionDisplacement's
-    // rotation about the empty axis, leaves round-off there)
+    // A component out of the frame is worth a warning from 1e-10 of the
+    // mesh's size and 1e-6 of the value on: below either it is the frame's
+    // own precision (solidBodyMotionDisplacement's rotation about the empty
+    // axis leaves round-off there; the wedge planes of OpenFOAM's movingCone,
+    // its vertices given to 8 digits, meet in an axis 7e-9 rad off x)
     const bool twoD = frame.size() < 3;
     const scalar outOfPlane = 1e-10*pMesh_().bounds().mag();
     forAll(meshPoints, i)
@@ -231,13 +233,14 @@ void Foam::boundaryConstraints::readFixedPatch
         {
             if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
         }
-        if
-        (
-            twoD
-         && mag(values[i] - frame.inFrame(pointi, values[i])) > outOfPlane
-        )
+        if (twoD)
         {
-            emptyDirection.insert(pp.name());
+            const scalar across =
+                mag(values[i] - frame.inFrame(pointi, values[i]));
+            if (across > outOfPlane && across > 1e-6*mag(values[i]))
+            {
+                emptyDirection.insert(pp.name());
+            }
         }
     }
 }
