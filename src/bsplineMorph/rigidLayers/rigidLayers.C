@@ -18,7 +18,6 @@ License
 #include "rigidLayers.H"
 #include "coeffsInput.H"
 #include "boundaryConstraints.H"
-#include "emptyPolyPatch.H"
 #include "syncTools.H"
 #include "globalIndex.H"
 #include "bitSet.H"
@@ -85,7 +84,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     DynamicList<word> valid;
     forAll(pbm, patchi)
     {
-        if (!pbm[patchi].coupled() && !isA<emptyPolyPatch>(pbm[patchi]))
+        if (isWall(pbm[patchi]))
         {
             valid.append(pbm[patchi].name());
         }
@@ -104,7 +103,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
             {
                 match = match || (groups.found(group) && pattern.match(group));
             }
-            if (match && !pp.coupled() && !isA<emptyPolyPatch>(pp))
+            if (match && isWall(pp))
             {
                 ids.insert(patchi);
                 found = true;
@@ -114,7 +113,8 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
         {
             FatalIOErrorInFunction(dict)
                 << "patches: " << pattern << " matches no patch that can carry"
-                << " rigid layers (coupled and empty patches cannot); valid patches: "
+                << " rigid layers (coupled, empty and wedge patches cannot);"
+                << " valid patches: "
                 << flatOutput(valid) << ", and groups of them" << exit(FatalIOError);
         }
     }

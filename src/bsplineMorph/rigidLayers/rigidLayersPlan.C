@@ -126,6 +126,15 @@ namespace
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
+bool Foam::rigidLayers::isWall(const polyPatch& pp)
+{
+    return
+        !pp.coupled()
+     && !isA<emptyPolyPatch>(pp)
+     && !isA<wedgePolyPatch>(pp);
+}
+
+
 void Foam::rigidLayers::findWallPoints()
 {
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
@@ -370,12 +379,7 @@ void Foam::rigidLayers::findOutermost()
     bitSet onPatch(mesh_.nPoints());
     for (const polyPatch& pp : mesh_.boundaryMesh())
     {
-        if
-        (
-            !pp.coupled()
-         && !isA<emptyPolyPatch>(pp)
-         && !isA<wedgePolyPatch>(pp)
-        )
+        if (isWall(pp))
         {
             onPatch.set(pp.meshPoints());
         }
