@@ -135,7 +135,7 @@ bool Foam::rigidLayers::isWall(const polyPatch& pp)
 }
 
 
-void Foam::rigidLayers::findWallPoints()
+void Foam::rigidLayers::findWallPoints(const pointField& points0)
 {
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     // The wall points, and where each listed patch's points are among them
@@ -160,9 +160,11 @@ void Foam::rigidLayers::findWallPoints()
     label nEdges = 0;
     for (const label patchi : patchIDs_)
     {
+        // (of the undeformed walls: a restart reads a moved mesh)
+        const labelList& meshPoints = pbm[patchi].meshPoints();
         for (const edge& e : pbm[patchi].edges())
         {
-            edgeSum += e.mag(pbm[patchi].localPoints());
+            edgeSum += mag(points0[meshPoints[e.end()]] - points0[meshPoints[e.start()]]);
             ++nEdges;
         }
     }
@@ -410,7 +412,7 @@ void Foam::rigidLayers::findOutermost()
 
 void Foam::rigidLayers::plan(const pointField& points0)
 {
-    findWallPoints();
+    findWallPoints(points0);
     const globalIndex wallIndex(wallPoints_.size());
     findFeet(points0, footCandidates(points0, wallIndex));
     findOutermost();

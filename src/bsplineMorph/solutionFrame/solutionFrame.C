@@ -54,7 +54,7 @@ Foam::solutionFrame::solutionFrame
     origin_(Zero)
 {
     // The wedge planes (each patch's area-weighted normal and offset, on
-    // all ranks)
+    // all ranks; of points0: a restart reads a moved mesh)
     DynamicList<vector> normals;
     DynamicList<scalar> offsets;
     wordList names;
@@ -64,16 +64,15 @@ Foam::solutionFrame::solutionFrame
         {
             continue;
         }
-        const vectorField areas(pp.faceAreas());
-        const vectorField centres(pp.faceCentres());
         vector area(Zero);
         scalar magArea = 0;
         vector moment(Zero);
-        forAll(areas, facei)
+        for (const face& f : pp)
         {
-            area += areas[facei];
-            magArea += mag(areas[facei]);
-            moment += mag(areas[facei])*centres[facei];
+            const vector a = f.areaNormal(points0);
+            area += a;
+            magArea += mag(a);
+            moment += mag(a)*f.centre(points0);
         }
         reduce(area, sumOp<vector>());
         reduce(magArea, sumOp<scalar>());
