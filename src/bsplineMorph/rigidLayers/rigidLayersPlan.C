@@ -161,10 +161,10 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
     for (const label patchi : patchIDs_)
     {
         // (of the undeformed walls: a restart reads a moved mesh)
-        const labelList& meshPoints = pbm[patchi].meshPoints();
+        const labelList& mp = pbm[patchi].meshPoints();
         for (const edge& e : pbm[patchi].edges())
         {
-            edgeSum += mag(points0[meshPoints[e.end()]] - points0[meshPoints[e.start()]]);
+            edgeSum += mag(points0[mp[e.end()]] - points0[mp[e.start()]]);
             ++nEdges;
         }
     }
