@@ -316,6 +316,64 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
         CHECK(foldedOnly > 0);
         CHECK(shrunkFolded > 0);
     }
+
+    SECTION("every face checkMesh calls a non-orthogonality error has a flagged cell")
+    {
+        // Faces need no check of their own: d . S is three times the sum of
+        // the face's two pyramids, so a face at 90 deg or more has one that
+        // turned. Every point moved by a pseudo-random fraction of a cell
+        // (a function of its position: the same on every rank), seeded
+        const vector h(0.1, 0.125, 1.0/6);
+        const auto noise = [](const point& x, const scalar k)
+        {
+            const scalar v = std::sin(x & vector(12.9898*k, 78.233*k, 37.719*k))*43758.5453;
+            return 2*(v - std::floor(v)) - 1;
+        };
+        label nErrorFaces = 0;
+        for (const scalar a : {0.2, 0.35, 0.5, 0.65, 0.8})
+        {
+            pointField p(p0);
+            forAll(p, pointi)
+            {
+                const point& x = p0[pointi];
+                p[pointi] += a*vector(h.x()*noise(x, 1), h.y()*noise(x, 2), h.z()*noise(x, 3));
+            }
+            const invertedCellCheck::result r = check.check(p);
+            CHECK(r.nInvalid == checkMeshInvalidCells(mesh, p));
+            polyMesh copy
+            (
+                IOobject("orthogonalityCopy", mesh.time().constant(), mesh.time(),
+                    IOobject::NO_READ, IOobject::NO_WRITE, false),
+                pointField(p),
+                faceList(mesh.faces()),
+                labelList(mesh.faceOwner()),
+                labelList(mesh.faceNeighbour()),
+                false
+            );
+            const scalarField ortho
+            (
+                primitiveMeshTools::faceOrthogonality(copy, copy.faceAreas(), copy.cellCentres())
+            );
+            boolList flagged(mesh.nCells(), false);
+            UIndirectList<bool>(flagged, r.cells) = true;
+            label nHere = 0, nMissed = 0;
+            forAll(ortho, facei)
+            {
+                if (ortho[facei] <= SMALL)    // checkMesh's "non-orthogonality error"
+                {
+                    ++nHere;
+                    nMissed +=
+                        !flagged[mesh.faceOwner()[facei]] && !flagged[mesh.faceNeighbour()[facei]];
+                }
+            }
+            INFO("noise " << a << " of a cell: " << r.nInvalid << " invalid cells, "
+                << nHere << " faces at 90 deg or more on this rank");
+            CHECK(nMissed == 0);
+            nErrorFaces += returnReduce(nHere, sumOp<label>());
+        }
+        // (the noise reaches such faces: the check above is not vacuous)
+        CHECK(nErrorFaces > 0);
+    }
 }
 
 
