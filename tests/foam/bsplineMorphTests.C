@@ -129,6 +129,22 @@ TEST_CASE("multilevelBSpline: the defaults give a working solver", "[foam][bspli
 
 namespace
 {
+    // A copy of the mesh with these points (its own geometry: cell centres,
+    // volumes, face areas), registered nowhere
+    autoPtr<polyMesh> movedCopy(const polyMesh& mesh, const pointField& p)
+    {
+        return autoPtr<polyMesh>::New
+        (
+            IOobject("movedCopy", mesh.time().constant(), mesh.time(),
+                IOobject::NO_READ, IOobject::NO_WRITE, false),
+            pointField(p),
+            faceList(mesh.faces()),
+            labelList(mesh.faceOwner()),
+            labelList(mesh.faceNeighbour()),
+            false
+        );
+    }
+
     // checkMesh's own verdict on the mesh's cells with these points: a copy
     // of the mesh moved to them (its cell centres and volumes), its cell
     // volumes below VSMALL and the face pyramids against its centres below
@@ -138,16 +154,8 @@ namespace
     // cell too small for SMALL); the number of cells with any (all ranks)
     label checkMeshInvalidCells(const polyMesh& mesh, const pointField& p)
     {
-        polyMesh copy
-        (
-            IOobject("checkMeshCopy", mesh.time().constant(), mesh.time(),
-                IOobject::NO_READ, IOobject::NO_WRITE, false),
-            pointField(p),
-            faceList(mesh.faces()),
-            labelList(mesh.faceOwner()),
-            labelList(mesh.faceNeighbour()),
-            false
-        );
+        const autoPtr<polyMesh> moved = movedCopy(mesh, p);
+        const polyMesh& copy = moved();
         boolList invalid(mesh.nCells(), false);
         forAll(copy.cellVolumes(), celli)
         {
@@ -340,16 +348,8 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
             }
             const invertedCellCheck::result r = check.check(p);
             CHECK(r.nInvalid == checkMeshInvalidCells(mesh, p));
-            polyMesh copy
-            (
-                IOobject("orthogonalityCopy", mesh.time().constant(), mesh.time(),
-                    IOobject::NO_READ, IOobject::NO_WRITE, false),
-                pointField(p),
-                faceList(mesh.faces()),
-                labelList(mesh.faceOwner()),
-                labelList(mesh.faceNeighbour()),
-                false
-            );
+            const autoPtr<polyMesh> moved = movedCopy(mesh, p);
+            const polyMesh& copy = moved();
             const scalarField ortho
             (
                 primitiveMeshTools::faceOrthogonality(copy, copy.faceAreas(), copy.cellCentres())
