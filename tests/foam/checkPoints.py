@@ -183,11 +183,19 @@ def coneLayers(case, time, inner, plain=None, tol=1e-12):
         off = np.abs(q1 - p0 - move).max(axis=1)[zone].max()
         check(off > 1e-3*size, "without rigidLayers they do not (largest departure %.3g)" % off)
 
+def tolOption():
+    """--tol T of the command line (default 1e-12)"""
+    return float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+
+def positionals():
+    """The command line's arguments after the mode, less the options and --tol's value"""
+    return [a for i, a in enumerate(sys.argv[2:], 2) if not a.startswith("--") and sys.argv[i - 1] != "--tol"]
+
 def main():
     mode = sys.argv[1]
     if mode == "equal":
         a, b, time = sys.argv[2:5]
-        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        tol = tolOption()
         c = comparePoints(a, b, time)
         check(c["nA"] == c["nB"], "same number of points (%d, %d)" % (c["nA"], c["nB"]))
         check(c["diff"] <= tol*c["size"], "largest difference %.3e <= %.1e x domain size %.3g"
@@ -195,7 +203,7 @@ def main():
     elif mode == "at":
         case, time = sys.argv[2:4]
         x0, x1 = [float(v) for v in sys.argv[4:7]], [float(v) for v in sys.argv[7:10]]
-        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        tol = tolOption()
         p0, p1 = pointsAt(case, "constant"), pointsAt(case, time)
         i = min(range(len(p0)), key=lambda k: sum((p0[k][d] - x0[d])**2 for d in range(3)))
         check(max(abs(p0[i][d] - x0[d]) for d in range(3)) < 1e-9, "a point at %s" % x0)
@@ -205,7 +213,7 @@ def main():
         import numpy as np
         case, time, inner = sys.argv[2], sys.argv[3], float(sys.argv[4])
         twoD = "--2d" in sys.argv
-        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        tol = tolOption()
         p0, p1 = np.array(pointsAt(case, "constant")), np.array(pointsAt(case, time))
         inf = np.abs(p0[:, :2 if twoD else 3] - 0.5).max(axis=1)
         hole = np.abs(inf - 0.15) < 1e-12
@@ -248,12 +256,12 @@ def main():
     elif mode == "tiltedSlip":
         tiltedSlip(sys.argv[2])
     elif mode == "wedge":
-        args = [a for i, a in enumerate(sys.argv[2:], 2) if not a.startswith("--") and sys.argv[i - 1] != "--tol"]
-        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        args = positionals()
+        tol = tolOption()
         wedge(*args[:3], tol=tol, axial="--axial" in sys.argv)
     elif mode == "coneLayers":
-        args = [a for i, a in enumerate(sys.argv[2:], 2) if not a.startswith("--") and sys.argv[i - 1] != "--tol"]
-        tol = float(sys.argv[sys.argv.index("--tol") + 1]) if "--tol" in sys.argv else 1e-12
+        args = positionals()
+        tol = tolOption()
         coneLayers(args[0], args[1], float(args[2]), *args[3:4], tol=tol)
     else:
         case, time = sys.argv[2:4]
