@@ -151,11 +151,11 @@ namespace
     // -SMALL that checkCellVolumes and checkFacePyramids report (each
     // pyramid on its own side), and those below -1e-10 of their scale
     // |S| |h| / 3 (invertedCellCheck::turnedFraction: a face turned in a
-    // cell too small for SMALL); the number of cells with any (all ranks)
-    label checkMeshInvalidCells(const polyMesh& mesh, const pointField& p)
+    // cell too small for SMALL); the number of cells with any (all ranks).
+    // Of copy, the mesh moved by movedCopy
+    label checkMeshInvalidCells(const polyMesh& mesh, const polyMesh& copy)
     {
-        const autoPtr<polyMesh> moved = movedCopy(mesh, p);
-        const polyMesh& copy = moved();
+        const pointField& p = copy.points();
         boolList invalid(mesh.nCells(), false);
         forAll(copy.cellVolumes(), celli)
         {
@@ -180,6 +180,12 @@ namespace
             if (neiPyrVol[facei] < -SMALL || neiPyrVol[facei] < -scale) invalid[n] = true;
         }
         return returnReduce(label(std::count(invalid.begin(), invalid.end(), true)), sumOp<label>());
+    }
+
+    // The same, for the mesh moved to p
+    label checkMeshInvalidCells(const polyMesh& mesh, const pointField& p)
+    {
+        return checkMeshInvalidCells(mesh, movedCopy(mesh, p)());
     }
 }
 
@@ -347,9 +353,9 @@ TEST_CASE("The inverted-cell check counts the cells checkMesh calls an error", "
                 p[pointi] += a*vector(h.x()*noise(x, 1), h.y()*noise(x, 2), h.z()*noise(x, 3));
             }
             const invertedCellCheck::result r = check.check(p);
-            CHECK(r.nInvalid == checkMeshInvalidCells(mesh, p));
             const autoPtr<polyMesh> moved = movedCopy(mesh, p);
             const polyMesh& copy = moved();
+            CHECK(r.nInvalid == checkMeshInvalidCells(mesh, copy));
             const scalarField ortho
             (
                 primitiveMeshTools::faceOrthogonality(copy, copy.faceAreas(), copy.cellCentres())
