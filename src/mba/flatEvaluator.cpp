@@ -263,17 +263,12 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     stencilTiles<D> tid;
     for (std::size_t q = 0; q < eval_.size(); ++q)
     {
-        const point<D>& u0 = eval_.u0[q];
         std::uint32_t m = 0;
         for (int k = flatLevel_ + 1; k < nPlanned; ++k)
         {
             const levelPlan<D>& L = levels[k];
-            const stencil<D> st = levelStencil<D>(u0, L.scale);
-            if (!findTiles(L.view, st, tid)) break;
-            // (weights are >= 0: the weighted sum of 1/omega is > 0 exactly
-            // where a node of non-zero weight has coefficients)
-            double w[3] = {0, 0, 0};
-            evalStencil(L.invOmega.data(), ctrl_.omegaPerNode, tid, st, w);
+            double w[3];
+            if (!coefficientWeights(L, q, tid, w)) break;
             if (!(w[0] + w[1] + w[2] > 0)) continue;
             m |= std::uint32_t(1) << (k - flatLevel_ - 1);
             finerLevelTiles_.push_back(tid);
@@ -284,6 +279,38 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     finerLevelPoints_.shrink_to_fit();
     finerLevelTiles_.shrink_to_fit();
     return read;
+}
+
+/// The weighted sum of 1/omega over the stencil at level L of the
+/// evaluation point at position q of the sweep, in w (per component, or
+/// w[0] for all when a node holds one omega): the weights are >= 0, so it
+/// is > 0 exactly where a node of non-zero weight has coefficients. False
+/// when no tile of L's view meets the stencil (nor does any finer level's:
+/// their nodes lie within the stencils of the same control points).
+template <int D>
+bool flatEvaluator<D>::coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid,
+                                          double w[3]) const
+{
+    const stencil<D> st = levelStencil<D>(eval_.u0[q], L.scale);
+    w[0] = w[1] = w[2] = 0;
+    if (!findTiles(L.view, st, tid)) return false;
+    evalStencil(L.invOmega.data(), ctrl_.omegaPerNode, tid, st, w);
+    return true;
+}
+
+template <int D>
+bool flatEvaluator<D>::reads(const levelPlan<D>& L) const
+{
+    stencilTiles<D> tid;
+    double w[3];
+    for (std::size_t q = 0; q < eval_.size(); ++q)
+    {
+        if (!coefficientWeights(L, q, tid, w)) continue;
+        const std::size_t i = eval_.at(q);
+        for (int c = 0; c < nc_; ++c)
+            if (w[ctrl_.omegaPerNode == 1 ? 0 : c] > 0 && eval_.reads(i, c)) return true;
+    }
+    return false;
 }
 
 /// Separated levels: the points whose phi is stored in every fit are those

@@ -49,6 +49,7 @@ class flatEvaluator
     void foldLevels(const std::deque<levelPlan<D>>& levels, int m, const affineFit<D>& affine);
     void addAffine(const indexBox<D>& b, const affineFit<D>& affine);
     void addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b);
+    bool coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid, double w[3]) const;
     std::vector<std::vector<std::uint8_t>> findFinerLevels(const std::deque<levelPlan<D>>& levels);
     void markReadEveryFit(std::deque<levelPlan<D>>& levels, std::vector<std::vector<std::uint8_t>>& read,
                           int nRanks) const;
@@ -66,6 +67,10 @@ public:
     /// needs; then also which points of separated levels must be stored in
     /// every fit (levelPlan::readEveryFit). nRanks: the communicator's size
     void update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine, int nRanks);
+
+    /// Whether a node of L with coefficients lies in the stencil of one of
+    /// this rank's evaluation points, in a component the points' mask reads
+    bool reads(const levelPlan<D>& L) const;
 
     /// Whether there is a flat lattice (else evaluate() does not apply)
     bool active() const { return flatLevel_ >= 0; }

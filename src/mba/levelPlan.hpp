@@ -101,6 +101,10 @@ struct levelPlan
     std::vector<std::int64_t> treeStart;    ///< tree: per view tile, where its values start (-1: none)
     std::vector<std::uint64_t> treeNodes;   ///< tree: per view tile, its nodes among them (bit n: node n)
 
+    /// Some evaluation point reads the level (found only for
+    /// params::stopUnread; a fit stops before a level that none reads)
+    bool read = true;
+
     levelStats stats;
 
     /// The layout of the own tiles

@@ -56,9 +56,9 @@ struct multilevel<D>::state
     fitReport report;                   ///< of the last fit
 
     state(const communicator& c, const params& p, int nc, pointsView<D> control, std::vector<std::uint8_t> mask,
-          pointsView<D> evaluation)
+          pointsView<D> evaluation, std::vector<std::uint8_t> evaluationMask)
     :
-        comm(c), parameters(p), ctrl(control, nc, std::move(mask)), eval(evaluation),
+        comm(c), parameters(p), ctrl(control, nc, std::move(mask)), eval(evaluation, nc, std::move(evaluationMask)),
         applier(comm, dom, ctrl), evaluator(eval, ctrl, dom)
     {}
 
@@ -82,6 +82,9 @@ void multilevel<D>::state::checkInput() const
         precondition(ctrl.mask.empty() || ctrl.mask.size() == ctrl.x.size*nc,
             "mba: the mask has " + std::to_string(ctrl.mask.size()) + " entries, expected "
             + std::to_string(ctrl.x.size*nc) + " (control points x components)");
+        precondition(eval.mask.empty() || eval.mask.size() == eval.x.size*nc,
+            "mba: the evaluation mask has " + std::to_string(eval.mask.size()) + " entries, expected "
+            + std::to_string(eval.x.size*nc) + " (evaluation points x components)");
         for (std::size_t i = 0; i < ctrl.x.size; ++i)
             for (int d = 0; d < D; ++d)
                 if (!std::isfinite(ctrl.x[i][d]))
@@ -123,7 +126,16 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
                           pointsView<D> control, std::vector<std::uint8_t> mask,
                           pointsView<D> evaluation, const box<D>* bounds)
 :
-    state_(new state(comm, p, nComponents, control, std::move(mask), evaluation))
+    multilevel(comm, p, nComponents, control, std::move(mask), evaluation, std::vector<std::uint8_t>(), bounds)
+{}
+
+template <int D>
+multilevel<D>::multilevel(const communicator& comm, const params& p, int nComponents,
+                          pointsView<D> control, std::vector<std::uint8_t> mask,
+                          pointsView<D> evaluation, std::vector<std::uint8_t> evaluationMask,
+                          const box<D>* bounds)
+:
+    state_(new state(comm, p, nComponents, control, std::move(mask), evaluation, std::move(evaluationMask)))
 {
     state& s = self();
     s.checkInput();
@@ -240,7 +252,14 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
             const double t1 = now();
             s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
                                             s.parameters.exchange));
-            s.levels.back().stats.planSeconds = now() - t1;
+            levelPlan<D>& L = s.levels.back();
+            if (s.parameters.stopUnread) L.read = s.comm.max(s.evaluator.reads(L) ? 1.0 : 0.0) > 0;
+            L.stats.planSeconds = now() - t1;
+        }
+        if (!s.levels[k].read)
+        {
+            rep.unread = true;
+            break;
         }
         const double t1 = now();
         s.applier.apply(s.levels[k], s.residuals);

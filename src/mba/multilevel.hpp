@@ -78,6 +78,14 @@ struct params
     /// directly.
     enum class exchangeMode { automatic, direct, chunked, tree };
     exchangeMode exchange = exchangeMode::automatic;
+    /// Stop before a level that no evaluation point reads: where none of
+    /// the level's nodes with coefficients lies in an evaluation point's
+    /// stencil (in a component the evaluation mask asks for), neither do
+    /// any finer level's, so those levels would only bring the control
+    /// points' residuals down, and evaluate() gives the same values without
+    /// them. Off by default: evaluate(x) and evaluateControl() then see
+    /// every level the tolerance needs.
+    bool stopUnread = false;
 
     /// Throws std::invalid_argument naming the offending parameter
     void validate() const;
@@ -117,6 +125,9 @@ struct fitReport
     double rmsResidual = 0;         ///< final (global)
     double seconds = 0;
     bool converged = false;         ///< maxResidual <= threshold
+    /// Stopped above the threshold before a level that no evaluation point
+    /// reads (params::stopUnread)
+    bool unread = false;
 };
 
 template <int D>
@@ -136,9 +147,18 @@ public:
     multilevel(const communicator& comm, const params& p, int nComponents,
                pointsView<D> control, std::vector<std::uint8_t> mask,
                pointsView<D> evaluation, const box<D>* bounds = nullptr);
+    /// The same, and which values the caller reads at the evaluation points:
+    /// evaluationMask per evaluation point x component 0/1 (empty: all), for
+    /// params::stopUnread (evaluate() still gives every component)
+    multilevel(const communicator& comm, const params& p, int nComponents,
+               pointsView<D> control, std::vector<std::uint8_t> mask,
+               pointsView<D> evaluation, std::vector<std::uint8_t> evaluationMask,
+               const box<D>* bounds = nullptr);
     /// The plan keeps the communicator: a temporary one would dangle
     multilevel(const communicator&&, const params&, int, pointsView<D>, std::vector<std::uint8_t>,
                pointsView<D>, const box<D>* = nullptr) = delete;
+    multilevel(const communicator&&, const params&, int, pointsView<D>, std::vector<std::uint8_t>,
+               pointsView<D>, std::vector<std::uint8_t>, const box<D>* = nullptr) = delete;
     ~multilevel();
 
     /// Fit the control values (point x component; unconstrained components are

@@ -69,7 +69,7 @@ void evaluationPoints<D>::arrange(const domain<D>& dom)
 template <int D>
 std::int64_t evaluationPoints<D>::bytes() const
 {
-    return std::int64_t((order.capacity() + position.capacity())*sizeof(std::uint32_t)
+    return std::int64_t(mask.capacity() + (order.capacity() + position.capacity())*sizeof(std::uint32_t)
         + u0.capacity()*sizeof(point<D>));
 }
 

@@ -10,6 +10,7 @@
 #include "lattice.hpp"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace mba {
@@ -73,6 +74,8 @@ template <int D>
 struct evaluationPoints
 {
     pointsView<D> x;                        ///< coordinates (the caller's: not copied)
+    int nComponents = 1;                    ///< values a point
+    std::vector<std::uint8_t> mask;         ///< point x component 0/1: the caller reads it; empty: all
     /// The sweep's order: spatial, or empty: the points' own order (when that
     /// is about as short a path through them: the results are then written in
     /// sequence)
@@ -81,7 +84,13 @@ struct evaluationPoints
     hugeVector<point<D>> u0;                ///< level-0 local coordinates, in the sweep's order
     point<D> lo0, hi0;                      ///< level-0 local box of the points
 
-    explicit evaluationPoints(pointsView<D> points) : x(points) {}
+    evaluationPoints(pointsView<D> points, int nc, std::vector<std::uint8_t> readMask)
+    :
+        x(points), nComponents(nc), mask(std::move(readMask))
+    {}
+
+    /// Whether the caller reads component c of point i
+    bool reads(std::size_t i, int c) const { return mask.empty() || mask[i*nComponents + c] != 0; }
 
     /// Sets order, position, u0 and their box (the domain contains the points)
     void arrange(const domain<D>& dom);
@@ -91,7 +100,7 @@ struct evaluationPoints
     /// The point at position q of the sweep's order
     std::size_t at(std::size_t q) const { return order.empty() ? q : order[q]; }
 
-    /// Bytes of the order and the coordinates
+    /// Bytes of the mask, the order and the coordinates
     std::int64_t bytes() const;
 };
 

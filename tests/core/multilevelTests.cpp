@@ -323,6 +323,68 @@ TEST_CASE("masked components constrain only what they mask", "[core]")
     }
 }
 
+namespace {
+
+template <int D>
+void stopsBeforeUnreadLevels()
+{
+    const slidingWall<D> w(12);
+    params p;
+    p.tolerance = 1e-12;
+    p.maxLevels = 14;
+    multilevel<D> full(serial(), p, D, w.c, w.mask, w.e);
+    const fitReport rf = full.fit(w.v);
+    std::vector<double> ref, out;
+    full.evaluate(ref);
+    REQUIRE(rf.converged);
+    p.stopUnread = true;
+    // Every value read: the sliding face's own points read their normal
+    // component, which its control points constrain at every level
+    {
+        multilevel<D> m(serial(), p, D, w.c, w.mask, w.e);
+        const fitReport& r = m.fit(w.v);
+        CHECK(r.levels == rf.levels);
+        CHECK(!r.unread);
+        m.evaluate(out);
+        CHECK(out == ref);
+    }
+    // The values the mask reads: no level past the fifth reaches them (the
+    // inner points lie 0.25 from the faces, the face's points 1 from the
+    // other face's), and they are the full fit's
+    multilevel<D> m(serial(), p, D, w.c, w.mask, w.e, w.evaluationMask);
+    const fitReport& r = m.fit(w.v);
+    INFO("D " << D << ": " << r.levels << " levels, the full fit " << rf.levels);
+    CHECK(r.unread);
+    CHECK(!r.converged);
+    CHECK(r.maxResidual > r.threshold);
+    CHECK(r.levels >= 3);
+    CHECK(r.levels <= 6);
+    CHECK(r.levels < rf.levels);
+    m.evaluate(out);
+    double diff = 0;
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (w.evaluationMask[i]) diff = std::max(diff, std::abs(out[i] - ref[i]));
+    // (the same coefficients; the flat lattice may fold fewer levels)
+    CHECK(diff <= 1e-14*maxAbs(w.v));
+    // where the level that stopped the fit is read after all, it counts:
+    // one more point just inside the sliding face
+    std::vector<point<D>> e = w.e;
+    std::vector<std::uint8_t> em = w.evaluationMask;
+    e.push_back(w.e.front());
+    e.back()[D - 1] += 1e-3;
+    em.insert(em.end(), D, 1);
+    multilevel<D> near(serial(), p, D, w.c, w.mask, e, em);
+    CHECK(near.fit(w.v).levels > r.levels);
+}
+
+} // namespace
+
+TEST_CASE("a fit can stop before the levels that no evaluation point reads", "[core]")
+{
+    stopsBeforeUnreadLevels<2>();
+    stopsBeforeUnreadLevels<3>();
+}
+
 TEST_CASE("bad input gets a clear error", "[core][errors]")
 {
     auto c = randomPoints<3>(20, 51);
@@ -350,6 +412,8 @@ TEST_CASE("bad input gets a clear error", "[core][errors]")
         multilevel<3> m(serial(), p, 2, c, {}, e);
         REQUIRE_THROWS_WITH(m.fit(std::vector<double>(20, 1.0)), Contains("20 control values, expected 40"));
         REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 2, c, std::vector<std::uint8_t>(3, 1), e)), Contains("mask"));
+        REQUIRE_THROWS_WITH((multilevel<3>(serial(), p, 2, c, {}, e, std::vector<std::uint8_t>(3, 1))),
+            Contains("the evaluation mask has 3 entries, expected 40 (evaluation points x components)"));
     }
     SECTION("zero or negative parameters")
     {

@@ -55,6 +55,8 @@ struct problem
     params p;
     bool masked = false;
     std::vector<std::vector<levelStats>>* stats = nullptr;   ///< per rank, when given
+    std::vector<std::uint8_t> evaluationMask;                ///< per evaluation point x component (empty: all)
+    std::vector<fitReport>* reports = nullptr;               ///< per rank, when given
 };
 
 /// Values at every evaluation point (global order) from P ranks
@@ -69,6 +71,7 @@ std::vector<double> solve(int P, partition how, const std::vector<point<D>>& c, 
         std::vector<double> vl;
         std::vector<std::uint8_t> ml;
         std::vector<std::size_t> eg;
+        std::vector<std::uint8_t> eml;
         for (std::size_t i = 0; i < c.size(); ++i)
         {
             if (rc[i] != comm.rank()) continue;
@@ -79,13 +82,21 @@ std::vector<double> solve(int P, partition how, const std::vector<point<D>>& c, 
                 if (!mask.empty()) ml.push_back(mask[i*pb.nc + k]);
             }
         }
-        for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) { el.push_back(e[i]); eg.push_back(i); }
-        multilevel<D> m(comm, pb.p, pb.nc, cl, ml, el);
+        for (std::size_t i = 0; i < e.size(); ++i)
+        {
+            if (re[i] != comm.rank()) continue;
+            el.push_back(e[i]);
+            eg.push_back(i);
+            if (!pb.evaluationMask.empty())
+                eml.insert(eml.end(), &pb.evaluationMask[i*pb.nc], &pb.evaluationMask[i*pb.nc] + pb.nc);
+        }
+        multilevel<D> m(comm, pb.p, pb.nc, cl, ml, el, eml);
         m.fit(vl);
         m.fit(vl);   // a second apply through the plan
         std::vector<double> o;
         m.evaluate(o);
         if (pb.stats) (*pb.stats)[comm.rank()] = m.stats();
+        if (pb.reports) (*pb.reports)[comm.rank()] = m.report();
         for (std::size_t j = 0; j < eg.size(); ++j)
             for (int k = 0; k < pb.nc; ++k) out[eg[j]*pb.nc + k] = o[j*pb.nc + k];   // disjoint writes
     });
@@ -136,6 +147,38 @@ TEST_CASE("serial equals simulated ranks", "[parallel]")
     const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
     serialEqualsRanks<2>(affine, masked, how);
     serialEqualsRanks<3>(affine, masked, how);
+}
+
+TEST_CASE("a fit that stops before the unread levels: serial equals simulated ranks", "[parallel]")
+{
+    // (the sliding wall of the serial test; every rank stops at the same level)
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    const slidingWall<3> w(12);
+    problem pb;
+    pb.p.tolerance = 1e-12;
+    pb.p.maxLevels = 14;
+    pb.p.stopUnread = true;
+    pb.p.bucketTiles = 8;
+    pb.evaluationMask = w.evaluationMask;
+    std::vector<fitReport> reports(1);
+    pb.reports = &reports;
+    const std::vector<double> ref = solve<3>(1, how, w.c, w.v, w.mask, w.e, pb);
+    REQUIRE(reports[0].unread);
+    const int levels = reports[0].levels;
+    for (int P : {2, 3, 5, 8})
+    {
+        INFO("ranks " << P << ", partition " << name(how) << ", serial stops after " << levels << " levels");
+        reports.assign(P, fitReport());
+        const std::vector<double> got = solve<3>(P, how, w.c, w.v, w.mask, w.e, pb);
+        for (const fitReport& r : reports)
+        {
+            CHECK(r.unread);
+            CHECK(r.levels == levels);
+        }
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+        CHECK(diff <= 1e-12*maxAbs(w.v));
+    }
 }
 
 TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and serial's", "[parallel][chunks]")

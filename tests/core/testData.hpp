@@ -110,6 +110,42 @@ std::vector<mba::point<D>> insideFaces(const std::vector<mba::point<D>>& c, std:
     return p;
 }
 
+/// A wall that slides and one that is fixed, as a mesh gives them: the
+/// grids of twoFaces (jitter 0.3), the face x_(D-1) = 0 constraining only
+/// its normal component (D - 1: to 0), the face x_(D-1) = 1 all (smooth
+/// values); evaluated: the sliding face's points, which read all but the
+/// normal component (evaluationMask), and points 0.25 inside either face
+template <int D>
+struct slidingWall
+{
+    std::vector<mba::point<D>> c, e;
+    std::vector<std::uint8_t> mask, evaluationMask;
+    std::vector<double> v;
+
+    explicit slidingWall(int k)
+    {
+        c = twoFaces<D>(k, 0.3, 81);
+        for (const mba::point<D>& x : c)
+            for (int q = 0; q < D; ++q)
+            {
+                const bool slides = x[D - 1] < 0.5;
+                mask.push_back(!slides || q == D - 1);
+                v.push_back(slides ? 0.0 : smooth<D>(x, q));
+            }
+        for (const mba::point<D>& x : c)
+        {
+            if (x[D - 1] > 0.5) continue;
+            e.push_back(x);
+            for (int q = 0; q < D; ++q) evaluationMask.push_back(q != D - 1);
+        }
+        for (const mba::point<D>& x : insideFaces<D>(c, 3, 0.25))
+        {
+            e.push_back(x);
+            evaluationMask.insert(evaluationMask.end(), D, 1);
+        }
+    }
+};
+
 /// A mask (point x component) in which every other of n points leaves one
 /// of its nc components free, in turn: components with mixed masks
 inline std::vector<std::uint8_t> mixedMask(std::size_t n, int nc)

@@ -684,6 +684,40 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
 }
 
 
+std::vector<std::uint8_t> Foam::boundaryConstraints::interpolatedComponents
+(
+    const labelUList& points
+) const
+{
+    // (as constrain() takes the components out, and collectControls() makes
+    // them control values)
+    const solutionFrame& frame = *frame_;
+    const label nd = frame.size();
+    std::vector<std::uint8_t> read(nd*points.size(), 1);
+    if (frame.axisymmetric())
+    {
+        return read;
+    }
+    forAll(points, i)
+    {
+        const label pointi = points[i];
+        bool m[3];
+        if
+        (
+            !fixed_[pointi] && slide_[pointi].first() > 0
+         && frame.mask(pointi, slide_[pointi], m)
+        )
+        {
+            for (label k = 0; k < nd; ++k)
+            {
+                read[i*nd + k] = !m[k];
+            }
+        }
+    }
+    return read;
+}
+
+
 bool Foam::boundaryConstraints::sameControls
 (
     const labelList& points,

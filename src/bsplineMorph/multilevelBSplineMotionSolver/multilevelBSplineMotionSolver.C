@@ -98,6 +98,8 @@ namespace Foam
 
         public:
 
+            //- evalRead: per evaluation point x direction, whether the
+            //  solver reads its value (params.stopUnread)
             bsplineInterpolator
             (
                 const mba::communicator& comm,
@@ -105,7 +107,8 @@ namespace Foam
                 const boundaryConstraints& bc,
                 const pointField& points0,
                 const double* evalXyz,
-                const std::size_t nEval
+                const std::size_t nEval,
+                std::vector<std::uint8_t> evalRead
             )
             :
                 controlXyz_(controlCoordinates(bc, points0)),
@@ -113,7 +116,7 @@ namespace Foam
                 (
                     comm, params, D,
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
-                    bc.mask(), mba::pointsView<D>(evalXyz, nEval)
+                    bc.mask(), mba::pointsView<D>(evalXyz, nEval), std::move(evalRead)
                 )
             {}
 
@@ -158,7 +161,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     const mba::domain<D>& dom = plan_.dom();
     const scalar domainSize =
         dom.h0*scalar(*std::max_element(dom.n0.begin(), dom.n0.end()));
-    if (!r.converged && !warned_ && r.maxResidual > 1e-12*domainSize)
+    if (!r.converged && !r.unread && !warned_ && r.maxResidual > 1e-12*domainSize)
     {
         // (once: the step's log line says it every time)
         warned_ = true;
@@ -215,7 +218,8 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
         }
     }
     os  << "), max residual " << r.maxResidual
-        << " (threshold " << r.threshold << (r.converged ? "" : ", not reached")
+        << " (threshold " << r.threshold
+        << (r.converged ? "" : r.unread ? ", not needed: no finer level reaches an interpolated point" : ", not reached")
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
         << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
@@ -229,6 +233,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     report.add("maxResidual", r.maxResidual);
     report.add("threshold", r.threshold);
     report.add("converged", r.converged);
+    report.add("unread", r.unread);
     report.add("latticeNodes", nodes);
     report.add("planMB", planMB);
     report.add("bytes", bytes);
@@ -263,6 +268,8 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     (
         dict, "exchange", exchangeNames, mba::params::exchangeMode::automatic
     );
+    // (the solver reads the planned points only)
+    params_.stopUnread = true;
     warnUnknownKeywords
     ({
         "tolerance", "relativeTolerance", "maxLevels", "initialGrid",
@@ -316,18 +323,27 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
 {
     const label D = bc.frame().size();
     const std::size_t nEval = evalPoints().size();
+    // The values the solver reads at the evaluation points: the first fit's
+    // along the axes that constrain() takes out (before the re-fit,
+    // matchCyclic and the rigid layers read them) are not; the re-fit's are
+    // all read (moveBoundaryPoints matches the cyclic points first)
+    std::vector<std::uint8_t> read;
+    if (!refit)
+    {
+        read = bc.interpolatedComponents(evalPoints());
+    }
     std::unique_ptr<boundaryInterpolator> interpolator;
     try
     {
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read)));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read)));
         }
         else
         {
