@@ -161,7 +161,11 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     const mba::domain<D>& dom = plan_.dom();
     const scalar domainSize =
         dom.h0*scalar(*std::max_element(dom.n0.begin(), dom.n0.end()));
-    if (!r.converged && !r.unread && !warned_ && r.maxResidual > 1e-12*domainSize)
+    if
+    (
+        !r.converged && !r.unread && !warned_
+     && r.maxResidual > 1e-12*domainSize
+    )
     {
         // (once: the step's log line says it every time)
         warned_ = true;
@@ -217,9 +221,12 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
             os  << ", " << tree << " tree";
         }
     }
+    const char* reached =
+        r.converged ? ""
+      : r.unread ? ", not needed: no finer level reaches an interpolated point"
+      : ", not reached";
     os  << "), max residual " << r.maxResidual
-        << " (threshold " << r.threshold
-        << (r.converged ? "" : r.unread ? ", not needed: no finer level reaches an interpolated point" : ", not reached")
+        << " (threshold " << r.threshold << reached
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
         << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
