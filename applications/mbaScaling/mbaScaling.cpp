@@ -344,7 +344,8 @@ rankResult runRanks(const options& o, int P)
 {
     const std::array<int, 3> m = parts(P, o.decomposition);
     const long n = o.n;
-    params prm;   // the motion solver's defaults
+    params prm;   // the motion solver's defaults, and as it does,
+    prm.stopUnread = true;   // no level that no evaluated point reads
     prm.exchange = o.exchange;
     rankResult res;
     res.ranks.resize(P);
