@@ -157,7 +157,9 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
     }
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
     // too); separated levels hold phi already, chunked ones received it
-    if (!L.separated && !L.chunked) divideByOmega(L);
+    if (!L.separated && !L.chunked && !L.tree)
+        for (const auto& r : L.coefficientRuns) divideByOmega(L, r.first, r.second);
+    else if (L.tree) divideByOmega(L);
     subtractLevel(L, residuals);
 }
 
@@ -167,11 +169,17 @@ template <int D>
 void levelApplier<D>::clearLattice(levelPlan<D>& L) const
 {
     const int blk = levelPlan<D>::npt*ctrl_.nComponents;
+    const int nc = ctrl_.nComponents;
     if (L.chunked || L.tree)
     {
         for (const std::int64_t id : L.ownInView) std::fill(L.phi.data() + id*blk, L.phi.data() + (id + 1)*blk, 0.0);
     }
-    else if (!L.separated) std::fill(L.phi.begin(), L.phi.end(), 0.0);
+    else if (!L.separated)
+    {
+        // (the other nodes hold 0 from the plan on: nothing adds to them)
+        for (const auto& r : L.coefficientRuns)
+            std::fill(L.phi.data() + r.first*nc, L.phi.data() + (r.first + r.second)*nc, 0.0);
+    }
     else
         for (const auto& tiles : L.tilesFrom)
             for (const std::int64_t id : tiles) std::fill(&L.phi[id*blk], &L.phi[(id + 1)*blk], 0.0);

@@ -84,6 +84,7 @@ class levelPlanner
     void testSeparation();
     void findGhostTiles();
     void chooseExchange();
+    void findCoefficientRuns();
     void considerTree();
     void dropDirectExchange();
     double exchangeCost(int rounds, std::int64_t messages, std::int64_t bytes) const;
@@ -128,6 +129,7 @@ levelPlan<D> levelPlanner<D>::run(int k)
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
         L_.receiveCounts[r] = L_.ghostTiles[r].empty() ? L_.tilesFrom[r].size()*npt*nc_ : L_.ghostTiles[r].size()*nc_;
     if (nRanks_ > 1) chooseExchange();
+    if (!L_.separated && !L_.chunked && !L_.tree) findCoefficientRuns();
     L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
@@ -138,6 +140,28 @@ levelPlan<D> levelPlanner<D>::run(int k)
     }
     fillStats();
     return std::move(L_);
+}
+
+/// levelPlan::coefficientRuns from 1/omega
+template <int D>
+void levelPlanner<D>::findCoefficientRuns()
+{
+    const int per = omegaPerNode_;
+    const std::int64_t nNodes = L_.view.size()*npt;
+    auto& runs = L_.coefficientRuns;
+    for (std::int64_t n = 0; n < nNodes; ++n)
+    {
+        bool any = false;
+        for (int j = 0; j < per; ++j) any = any || L_.invOmega[n*per + j] > 0;
+        if (!any) continue;
+        if (!runs.empty() && runs.back().first + runs.back().second == n) ++runs.back().second;
+        else runs.emplace_back(n, 1);
+    }
+    // (where most nodes have coefficients, one sweep over all is faster
+    // than the runs)
+    std::int64_t inRuns = 0;
+    for (const auto& r : runs) inRuns += r.second;
+    if (2*inRuns > nNodes) runs.assign(1, {0, nNodes});
 }
 
 /// This rank's tiles, the tiles of each control point's stencil (found once:

@@ -22,6 +22,7 @@
 #include "chunkExchange.hpp"
 
 #include <deque>
+#include <utility>
 
 namespace mba {
 
@@ -100,6 +101,13 @@ struct levelPlan
     std::int64_t treeValues = 0;            ///< tree: values summed
     std::vector<std::int64_t> treeStart;    ///< tree: per view tile, where its values start (-1: none)
     std::vector<std::uint64_t> treeNodes;   ///< tree: per view tile, its nodes among them (bit n: node n)
+
+    /// Plain levels (neither separated nor chunked nor tree): the view's
+    /// nodes where omega > 0 in some component, as runs [first, first + n)
+    /// of consecutive nodes, or one run of all nodes where those are most.
+    /// phi is 0 at every other node in every fit (no control point reaches
+    /// them), so an apply clears and divides these only.
+    std::vector<std::pair<std::int64_t, std::int64_t>> coefficientRuns;
 
     /// Some evaluation point reads the level (found only for
     /// params::stopUnread; a fit stops before a level that none reads)
