@@ -639,7 +639,8 @@ void levelPlanner<D>::fillStats()
     s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
-        + L.scaledResiduals.capacity()*sizeof(double));
+        + L.scaledResiduals.capacity()*sizeof(double)
+        + L.coefficientRuns.capacity()*sizeof(L.coefficientRuns[0]));
     if (L.tree)
     {
         const treeTraffic t = treeTrafficOf(nRanks_, me_, std::size_t(L.treeValues));
