@@ -1,0 +1,301 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+Description
+    boundaryConstraints: what the patches' conditions prescribe, read at
+    every step (update()): fixed values, sliding planes, and the checks of
+    what they prescribe (non-finite values, components across an empty or
+    wedge frame).
+
+\*---------------------------------------------------------------------------*/
+
+#include "boundaryConstraints.H"
+#include "sumsAndMaxima.H"
+#include "valuePointPatchFields.H"
+#include "facePointPatch.H"
+#include "emptyPointPatch.H"
+#include "OStringStream.H"
+#include "HashOps.H"
+
+#include <cmath>
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::boundaryConstraints::resetPointArrays()
+{
+    // The per-point arrays keep their storage from step to step (no new
+    // pages for the mesh-sized arrays at every step)
+    const label nPoints = pMesh_().nPoints();
+    labelList& fixed = fixedSync_;
+    if (fixed.size() != nPoints)
+    {
+        fixed.setSize(nPoints);
+        fixed = 0;
+        fixed_.setSize(nPoints);
+        fixed_ = false;
+        value_.setSize(nPoints);
+        value_ = Zero;
+        slide_.setSize(nPoints);
+        slide_ = pointConstraint();
+    }
+    // (only what the last update set is reset: storing a pointConstraint at
+    // every boundary point cost more than the rest of the update together)
+    for (const label pointi : boundaryPoints_)
+    {
+        if (fixed[pointi])
+        {
+            fixed[pointi] = 0;
+            value_[pointi] = Zero;
+        }
+        if (slide_[pointi].first())
+        {
+            slide_[pointi] = pointConstraint();
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::readFixedPatch
+(
+    const pointPatchVectorField& pf,
+    const vectorField& disp,
+    wordHashSet& nonFinite,
+    wordHashSet& emptyDirection
+)
+{
+    const pointPatch& pp = pf.patch();
+    const labelList& meshPoints = pp.meshPoints();
+    const solutionFrame& frame = *frame_;
+    // The condition's own values (the internal field at a point on a fixed
+    // and a slip patch depends on their evaluation order)
+    const valuePointPatchVectorField* vpf = isA<valuePointPatchVectorField>(pf);
+    const vectorField values
+    (
+        vpf
+      ? static_cast<const vectorField&>(*vpf)
+      : vectorField(disp, meshPoints)
+    );
+    // A component out of the frame is worth a warning from 1e-10 of the
+    // mesh's size and 1e-6 of the value on: below either it is the frame's
+    // own precision (solidBodyMotionDisplacement's rotation about the empty
+    // axis leaves round-off there; the wedge planes of OpenFOAM's movingCone,
+    // its vertices given to 8 digits, meet in an axis 7e-9 rad off x)
+    const bool twoD = frame.size() < 3;
+    const scalar outOfPlane = 1e-10*pMesh_().bounds().mag();
+    forAll(meshPoints, i)
+    {
+        const label pointi = meshPoints[i];
+        fixedSync_[pointi] = 1;
+        value_[pointi] = values[i];
+        for (direction c = 0; c < 3; ++c)
+        {
+            if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
+        }
+        if (twoD)
+        {
+            const scalar across =
+                mag(values[i] - frame.inFrame(pointi, values[i]));
+            if (across > outOfPlane && across > 1e-6*mag(values[i]))
+            {
+                emptyDirection.insert(pp.name());
+            }
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf)
+{
+    const pointPatch& pp = pf.patch();
+    const labelList& meshPoints = pp.meshPoints();
+    const solutionFrame& frame = *frame_;
+    if (frame.axisymmetric() && pp.constraintType() == "wedge")
+    {
+        // The frame keeps every point in its meridian plane
+        return;
+    }
+    // A plane's normal as the frame sees it at a point (zero: the plane
+    // holds nothing in the frame)
+    auto applyNormal = [&](const label pointi, const vector& n)
+    {
+        const vector m = frame.planeNormal(pointi, n);
+        if (m != vector::zero)
+        {
+            slide_[pointi].applyConstraint(m);
+        }
+    };
+    if (pf.type() == "slip" || pp.constraintType() == "symmetry")
+    {
+        // Each face's own normal on each of its points, combined (plane,
+        // line, fixed): a patch spanning several planes (the faces of a box)
+        // constrains its edge points to the line where they meet. Averaged
+        // point normals would not: they tilt at edges and differ between the
+        // ranks that share a point.
+        const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
+        const vectorField& nf = patch.faceNormals();
+        const faceList& lf = patch.localFaces();
+        forAll(lf, facei)
+        {
+            for (const label lp : lf[facei])
+            {
+                applyNormal(meshPoints[lp], nf[facei]);
+            }
+        }
+    }
+    else if (pf.type() == "fixedNormalSlip")
+    {
+        // The normal is private to the condition: read it back from its output
+        OStringStream os;
+        pf.write(os);
+        const dictionary d(IStringStream(os.str())());
+        vector n = d.get<vector>("n");
+        n /= mag(n) + VSMALL;
+        for (const label pointi : meshPoints)
+        {
+            applyNormal(pointi, n);
+        }
+    }
+    else if (pp.constraintType() != word::null)
+    {
+        // symmetryPlane, wedge, cyclicSlip: the patch's own constraint
+        forAll(meshPoints, i)
+        {
+            // (a plane: its normal as the frame sees it, as the slip
+            // patches' above)
+            pointConstraint pc;
+            pp.applyConstraint(i, pc);
+            if (pc.first() == 1)
+            {
+                applyNormal(meshPoints[i], pc.second());
+            }
+            else
+            {
+                slide_[meshPoints[i]].combine(pc);
+            }
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::checkPrescribed
+(
+    wordHashSet& nonFinite,
+    wordHashSet& emptyDirection
+)
+{
+    const polyMesh& mesh = pMesh_();
+
+    // Non-finite values stop everything here, on every rank, before they
+    // reach any arithmetic (with FOAM_SIGFPE a NaN comparison traps)
+    Pstream::combineGather(nonFinite, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(nonFinite);
+    if (nonFinite.size())
+    {
+        FatalErrorInFunction
+            << "pointDisplacement has non-finite (NaN or Inf) values on patches "
+            << flatOutput(nonFinite.sortedToc()) << " at time "
+            << mesh.time().timeName() << "; the mesh is not moved"
+            << exit(FatalError);
+    }
+
+    // A 2D case moves in its plane: a prescribed component out of it is
+    // dropped, with a warning (once per patch; a 3D case has none to
+    // gather, on any rank)
+    if (frame_->size() == 3)
+    {
+        return;
+    }
+    Pstream::combineGather(emptyDirection, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(emptyDirection);
+    emptyDirection -= warnedEmptyDirection_;
+    if (emptyDirection.size())
+    {
+        OStringStream names;
+        for (const word& name : emptyDirection.sortedToc())
+        {
+            names<< ' ' << name;
+        }
+        const bool axisymmetric = frame_->axisymmetric();
+        WarningInFunction
+            << "pointDisplacement prescribes a non-zero displacement"
+            << (
+                   axisymmetric
+                 ? " across the meridian planes (around the axis) of this"
+                   " axisymmetric (wedge) case"
+                 : " in the empty direction of this 2D case"
+               )
+            << " on patches:" << names.str().c_str() << ", at time "
+            << mesh.time().timeName() << ": that component is dropped (the"
+            << " mesh moves "
+            << (axisymmetric ? "along its axis and radii" : "in its plane")
+            << " only)" << endl;
+        warnedEmptyDirection_ += emptyDirection;
+    }
+}
+
+
+void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement)
+{
+    resetPointArrays();
+    wordHashSet nonFinite;
+    wordHashSet emptyDirection;
+    for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
+    {
+        if (pf.patch().coupled() || pf.type() == "empty")
+        {
+            continue;
+        }
+        if (pf.fixesValue())
+        {
+            readFixedPatch
+            (
+                pf, pointDisplacement.primitiveField(), nonFinite, emptyDirection
+            );
+        }
+        else
+        {
+            readSlidingPatch(pf);
+        }
+    }
+    checkPrescribed(nonFinite, emptyDirection);
+
+    // The points on an axisymmetric mesh's axis slide along it
+    if (frame_->axisymmetric())
+    {
+        const pointConstraint alongAxis
+        (
+            Tuple2<label, vector>(2, frame_->axis())
+        );
+        for (const label pointi : frame_->axisPoints())
+        {
+            slide_[pointi].combine(alongAxis);
+        }
+    }
+
+    // The same view of every processor-shared point on all its ranks (the
+    // conditions set values at their patches' points only)
+    conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
+    conditionPoints_->combineMesh(value_, maxMagSqrEqOp<vector>(), vector::zero);
+    conditionPoints_->combineMesh(slide_, combineConstraintsEqOp(), pointConstraint());
+
+    for (const label pointi : boundaryPoints_)
+    {
+        fixed_[pointi] = fixedSync_[pointi] != 0;
+    }
+    collectControls();
+}
+
+
+// ************************************************************************* //
