@@ -22,7 +22,7 @@
 // This header is the interface; the parts live in internal headers:
 // pointSets.hpp and spatialOrder.hpp (the points in spatial order),
 // levelPlan.hpp (a level's plan: tiles, buckets, requests, ghosts, the
-// separation test), levelApply.hpp (a level's apply in every fit),
+// separation test; levelPlanner.hpp the planner that makes it), levelApply.hpp (a level's apply in every fit),
 // flatEvaluator.hpp with subdivision.hpp and plainLattice.hpp (evaluation),
 // lattice.hpp and stencilKernels.hpp (tiled lattices and their kernels).
 #ifndef MBA_MULTILEVEL_HPP

@@ -1,0 +1,71 @@
+// bsplineMorph: OpenFOAM-free multilevel B-spline core (internal header)
+// The planner of one level (levelPlan.cpp: the steps of run(); the choice of
+// the level's exchange, chooseExchange() and what it uses:
+// levelPlanExchange.cpp).
+#ifndef MBA_LEVELPLANNER_HPP
+#define MBA_LEVELPLANNER_HPP
+
+#include "levelPlan.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace mba {
+
+/// The planning of one level, step after step (run() in order)
+template <int D>
+class levelPlanner
+{
+    static constexpr int npt = levelPlan<D>::npt;
+
+    const communicator& comm_;          ///< the ranks
+    const domain<D>& dom_;              ///< the lattices' domain
+    const controlPoints<D>& ctrl_;      ///< this rank's control points
+    const queryClusters<D>& clusters_;  ///< this rank's query points (parallel only)
+    const int bucketTiles_;             ///< target tiles per bucket (params::bucketTiles)
+    const params::exchangeMode mode_;   ///< how the partial sums meet (params::exchange)
+    const int nRanks_, me_;             ///< the communicator's size and this rank
+    const int nc_, omegaPerNode_;       ///< values a point, omega values a node (as ctrl_'s)
+
+    levelPlan<D> L_;                    ///< the plan being made
+    index<D> nodes_;                    ///< the level's nodes per direction
+    std::int64_t nOwn_ = 0;             ///< own tiles
+    std::vector<stencilTiles<D>> ownIds_; ///< the own points' stencil tiles in the own layout, in order
+    hugeVector<double> ownOmega_;       ///< this rank's partial omega on its own tiles (may become the view's)
+    std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
+    std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
+    std::vector<std::int64_t> ownToView_;              ///< own tile id -> view id (parallel)
+
+    void ownTilesAndOmega();
+    std::vector<std::vector<std::int64_t>> bucketDirectory();
+    std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
+    std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
+    void answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted);
+    void chooseGhosts();
+    void assembleView();
+    void sumOmega(const std::vector<std::int64_t>& ownToView);
+    void findControlTiles();
+    void testSeparation();
+    void findGhostTiles();
+    void chooseExchange();
+    void findCoefficientRuns();
+    void considerTree();
+    void dropDirectExchange();
+    double exchangeCost(int rounds, std::int64_t messages, std::int64_t bytes) const;
+    double currentExchangeCost() const;
+    double treeExchangeCost(std::int64_t n) const;
+    void fillStats();
+
+public:
+    levelPlanner(const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                 const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
+    :
+        comm_(comm), dom_(dom), ctrl_(ctrl), clusters_(clusters), bucketTiles_(bucketTiles), mode_(mode),
+        nRanks_(comm.size()), me_(comm.rank()), nc_(ctrl.nComponents), omegaPerNode_(ctrl.omegaPerNode)
+    {}
+
+    levelPlan<D> run(int k);
+};
+
+} // namespace mba
+#endif
