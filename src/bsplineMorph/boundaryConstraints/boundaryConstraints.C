@@ -17,16 +17,11 @@ License
 
 #include "boundaryConstraints.H"
 #include "sumsAndMaxima.H"
-#include "valuePointPatchFields.H"
 #include "syncTools.H"
 #include "globalMeshData.H"
 #include "polyMesh.H"
-#include "facePointPatch.H"
 #include "emptyPointPatch.H"
 #include "bitSet.H"
-#include "OStringStream.H"
-#include "IStringStream.H"
-#include "HashOps.H"
 #include "cyclicPolyPatch.H"
 #include "processorPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
@@ -161,6 +156,21 @@ Foam::boundaryConstraints::boundaryConstraints
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
+bool Foam::boundaryConstraints::heldComponents
+(
+    const label pointi,
+    bool held[3]
+) const
+{
+    if (fixed_[pointi])
+    {
+        held[0] = held[1] = held[2] = true;
+        return true;
+    }
+    return frame_->mask(pointi, slide_[pointi], held);
+}
+
+
 void Foam::boundaryConstraints::collectControls()
 {
     // Control points in the frame's directions
@@ -171,18 +181,11 @@ void Foam::boundaryConstraints::collectControls()
     values_.clear();
     for (const label pointi : boundaryPoints_)
     {
-        bool m[3] = {false, false, false};
-        if (fixed_[pointi])
+        bool m[3];
+        if (!heldComponents(pointi, m))
         {
-            m[0] = m[1] = m[2] = true;
-        }
-        else if (slide_[pointi].first() > 0)
-        {
-            if (!frame.mask(pointi, slide_[pointi], m))
-            {
-                proj.append(pointi);
-                continue;
-            }
+            proj.append(pointi);
+            continue;
         }
         bool any = false;
         for (label k = 0; k < nd; ++k)
@@ -422,24 +425,18 @@ std::vector<std::uint8_t> Foam::boundaryConstraints::interpolatedComponents
     const labelUList& points
 ) const
 {
-    // (as constrain() takes the components out, and collectControls() makes
-    // them control values)
-    const solutionFrame& frame = *frame_;
-    const label nd = frame.size();
+    // (the components constrain() sets and collectControls() makes control
+    // values)
+    const label nd = frame_->size();
     std::vector<std::uint8_t> read(nd*points.size(), 1);
-    if (frame.axisymmetric())
+    if (frame_->axisymmetric())
     {
         return read;
     }
     forAll(points, i)
     {
-        const label pointi = points[i];
         bool m[3];
-        if
-        (
-            !fixed_[pointi] && slide_[pointi].first() > 0
-         && frame.mask(pointi, slide_[pointi], m)
-        )
+        if (heldComponents(points[i], m))
         {
             for (label k = 0; k < nd; ++k)
             {
