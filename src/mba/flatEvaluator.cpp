@@ -253,7 +253,8 @@ void flatEvaluator<D>::addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b
 template <int D>
 std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const std::deque<levelPlan<D>>& levels)
 {
-    const int nPlanned = int(levels.size());
+    int nPlanned = 0;   // (up to a level that none reads)
+    while (nPlanned < int(levels.size()) && levels[nPlanned].read) ++nPlanned;
     precondition(nPlanned - flatLevel_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
     finerLevelPoints_.clear();
     finerLevelTiles_.clear();

@@ -79,7 +79,6 @@ levelPlan<D> levelPlanner<D>::run(int k)
         L_.receiveCounts[r] = L_.ghostTiles[r].empty() ? L_.tilesFrom[r].size()*npt*nc_ : L_.ghostTiles[r].size()*nc_;
     if (nRanks_ > 1) chooseExchange();
     if (!L_.separated && !L_.chunked && !L_.tree) findCoefficientRuns();
-    L_.phi.assign(L_.view.size()*npt*nc_, 0.0);
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
     {
@@ -437,7 +436,8 @@ void levelPlanner<D>::fillStats()
     s.chunked = L.chunked;
     s.tree = L.tree;
     s.nodes = L.view.size()*npt;
-    s.bytes = std::int64_t((L.phi.capacity() + L.invOmega.capacity())*sizeof(double)
+    // (phi as the first apply allocates it)
+    s.bytes = std::int64_t((L.view.size()*npt*nc_ + std::int64_t(L.invOmega.capacity()))*sizeof(double)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
         + L.scaledResiduals.capacity()*sizeof(double)

@@ -52,7 +52,9 @@ struct levelPlan
     bool ownIsView = false;         ///< serial, sparse: the own tiles are the view (ownLayout left empty)
 
     /// The coefficients at the view's nodes (tile id x node x component);
-    /// during an apply first the partial sums delta. Mutable: a separated
+    /// during an apply first the partial sums delta. Allocated by the first
+    /// apply (a level that no evaluation point reads never has them; see
+    /// unreadLevel). Mutable: a separated
     /// level's apply stores phi only where it is read every fit, and the
     /// const evaluations that read the whole lattice store the rest, from
     /// the last fit (storeDeferredCoefficients: a cache, not a change)
@@ -118,6 +120,21 @@ struct levelPlan
     /// The layout of the own tiles
     const tileLayout<D>& ownTiles() const { return ownIsView ? view : ownLayout; }
 };
+
+/// What a fit keeps of a level that no evaluation point reads
+/// (params::stopUnread): its index, scale and plan statistics, read false
+/// (every fit stops before it), no arrays
+template <int D>
+levelPlan<D> unreadLevel(const levelPlan<D>& L)
+{
+    levelPlan<D> u;
+    u.level = L.level;
+    u.scale = L.scale;
+    u.read = false;
+    u.stats = L.stats;
+    u.stats.bytes = 0;
+    return u;
+}
 
 /// Plans level k. Collective.
 template <int D>

@@ -366,6 +366,16 @@ void stopsBeforeUnreadLevels()
         if (w.evaluationMask[i]) diff = std::max(diff, std::abs(out[i] - ref[i]));
     // (the same coefficients; the flat lattice may fold fewer levels)
     CHECK(diff <= 1e-14*maxAbs(w.v));
+    // the plan keeps no arrays of the level it stopped before (the full
+    // fit's holds its lattice there), and the next fit stops there again
+    const std::vector<levelStats> st = m.stats(), stFull = full.stats();
+    REQUIRE(int(st.size()) == r.levels + 1);
+    CHECK(st.back().bytes == 0);
+    CHECK(stFull[r.levels].bytes > 0);
+    const std::vector<double> first = out;
+    CHECK(m.fit(w.v).levels == r.levels);
+    m.evaluate(out);
+    CHECK(out == first);
     // where the level that stopped the fit is read after all, it counts:
     // one more point just inside the sliding face
     std::vector<point<D>> e = w.e;
