@@ -53,11 +53,11 @@ struct levelPlan
 
     /// The coefficients at the view's nodes (tile id x node x component);
     /// during an apply first the partial sums delta. Allocated by the first
-    /// apply (a level that no evaluation point reads never has them; see
-    /// unreadLevel). Mutable: a separated
-    /// level's apply stores phi only where it is read every fit, and the
-    /// const evaluations that read the whole lattice store the rest, from
-    /// the last fit (storeDeferredCoefficients: a cache, not a change)
+    /// apply (a level that no evaluation point reads never has them: see
+    /// unreadLevel). Mutable: a separated level's apply stores phi only
+    /// where it is read every fit, and the const evaluations that read the
+    /// whole lattice store the rest, from the last fit
+    /// (storeDeferredCoefficients: a cache, not a change)
     mutable hugeVector<double> phi;
     hugeVector<double> invOmega;    ///< 1/omega at the view's nodes (0 where omega is), omegaPerNode a node
 
