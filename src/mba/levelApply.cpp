@@ -137,7 +137,7 @@ void evalRun(const double* phi, int nc, const stencilTiles<D>& tid, const stenci
 template <int D>
 void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
 {
-    const std::size_t nPhi = std::size_t(L.view.size())*levelPlan<D>::npt*ctrl_.nComponents;
+    const std::size_t nPhi = L.coefficientCount(ctrl_.nComponents);
     if (L.phi.size() != nPhi) L.phi.assign(nPhi, 0.0);
     // delta += w^2 phi_c = w^3 r_c / sum(w^2): this rank's partial sums, in
     // the view; in parallel the other ranks' are then added in rank order.

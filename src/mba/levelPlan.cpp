@@ -437,7 +437,7 @@ void levelPlanner<D>::fillStats()
     s.tree = L.tree;
     s.nodes = L.view.size()*npt;
     // (phi as the first apply allocates it)
-    s.bytes = std::int64_t((L.view.size()*npt*nc_ + std::int64_t(L.invOmega.capacity()))*sizeof(double)
+    s.bytes = std::int64_t((L.coefficientCount(nc_) + L.invOmega.capacity())*sizeof(double)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
         + L.scaledResiduals.capacity()*sizeof(double)

@@ -119,6 +119,9 @@ struct levelPlan
 
     /// The layout of the own tiles
     const tileLayout<D>& ownTiles() const { return ownIsView ? view : ownLayout; }
+
+    /// The values phi holds once allocated (nc a node)
+    std::size_t coefficientCount(int nc) const { return std::size_t(view.size())*npt*nc; }
 };
 
 /// What a fit keeps of a level that no evaluation point reads
