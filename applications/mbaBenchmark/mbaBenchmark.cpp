@@ -245,12 +245,12 @@ template <int D> int run(const options& o)
         }
     });
 
-    std::printf("%5s %12s %8s %10s %6s %9s %12s %12s %12s %9s %12s\n", "level", "h", "tiles", "nodes", "dense",
-                "separated", "MB", "max res", "rms res", "time s", "recv/apply");
+    std::printf("%5s %12s %8s %10s %6s %9s %8s %12s %12s %12s %9s %12s\n", "level", "h", "tiles", "nodes", "dense",
+                "separated", "lone", "MB", "max res", "rms res", "time s", "recv/apply");
     for (const auto& s : res.stats)
-        std::printf("%5d %12.4e %8lld %10lld %6s %9s %12.3f %12.3e %12.3e %9.4f %12lld\n", s.level, s.h,
+        std::printf("%5d %12.4e %8lld %10lld %6s %9s %8lld %12.3f %12.3e %12.3e %9.4f %12lld\n", s.level, s.h,
                     static_cast<long long>(s.viewTiles), static_cast<long long>(s.nodes), s.dense ? "yes" : "no",
-                    s.separated ? "yes" : "no", s.bytes/1048576.0,
+                    s.separated ? "yes" : "no", static_cast<long long>(s.lonePoints), s.bytes/1048576.0,
                     s.maxResidual, s.rmsResidual, s.seconds, static_cast<long long>(s.bytesReceivedPerApply));
     const double peak = res.peak;
     std::printf("fit %.4f s, apply %.4f s, evaluate %.4f s (%.2f M points/s), levels %d\n",

@@ -162,6 +162,7 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
     if (!L.separated && !L.chunked && !L.tree)
         for (const auto& r : L.coefficientRuns) divideByOmega(L, r.first, r.second);
     else if (L.tree) divideByOmega(L);
+    storeLonePoints(L, rr);
     subtractLevel(L, residuals);
 }
 
@@ -221,9 +222,9 @@ void levelApplier<D>::scaleResiduals(std::vector<double>& rr, const std::vector<
 }
 
 /// This rank's partial sums delta (separated: phi at the points read every
-/// fit). Runs of points with the same stencil nodes at once (coarse
-/// levels), short runs point after point: as the ranks holding them as
-/// ghosts form their sums (ghostPartialSums)
+/// fit), but for the lone points'. Runs of points with the same stencil
+/// nodes at once (coarse levels), short runs point after point: as the
+/// ranks holding them as ghosts form their sums (ghostPartialSums)
 template <int D>
 void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr) const
 {
@@ -245,10 +246,23 @@ void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr)
         for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
         if (e - q >= minRun)
             scatterRun<D>(L.phi.data(), nc, L.controlTiles[q], &cubedStencils_[q], &rr[q*nc], e - q);
-        else
+        else if (L.lone.empty() || !L.lone[q])
             for (std::size_t j = q; j < e; ++j)
                 scatter<D>(L.phi.data(), nc, L.controlTiles[j], cubedStencils_[j], &rr[j*nc]);
     }
+}
+
+/// The lone points' phi (levelPlan::lone): w r/sum(w^2) at their nodes, as
+/// a separated level stores it. After the exchange and the divide: what
+/// those nodes hold until then (0, or the last fit's phi where they are not
+/// cleared) is overwritten. Every component, 0 in those the point does not
+/// constrain (no other point does there either)
+template <int D>
+void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const
+{
+    const int nc = ctrl_.nComponents;
+    for (std::size_t q = 0; q < L.lone.size(); ++q)
+        if (L.lone[q]) scatterSeparated<D>(L.phi.data(), nc, L.controlTiles[q], stencils_[q], &rr[q*nc], nullptr);
 }
 
 /// Exchange the partial delta of the requested tiles, or the residuals of
@@ -484,6 +498,12 @@ void levelApplier<D>::subtractLevel(const levelPlan<D>& L, std::vector<double>& 
         for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
         if (e - q >= minBlockRun)
             evalRun<D>(L.phi.data(), nc, L.controlTiles[q], &stencils_[q], e - q, &levelValues_[q*nc]);
+        else if (!L.lone.empty() && L.lone[q])
+        {
+            // (as a separated level's: (r/sum(w^2)) sum(w^2))
+            const double sw = stencils_[q].sumSquares();
+            for (int c = 0; c < nc; ++c) levelValues_[q*nc + c] = scaledResiduals_[q*nc + c]*sw;
+        }
         else
             for (std::size_t j = q; j < e; ++j)
                 evalStencil(L.phi.data(), nc, L.controlTiles[j], stencils_[j], &levelValues_[j*nc]);

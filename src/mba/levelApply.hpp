@@ -42,6 +42,7 @@ class levelApplier
     void exchangeChunks(levelPlan<D>& L);
     void exchangeInTree(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L, std::int64_t first = 0, std::int64_t n = -1) const;
+    void storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const;
     void subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals);
 
 public:

@@ -72,6 +72,7 @@ levelPlan<D> levelPlanner<D>::run(int k)
     assembleView();
     findControlTiles();
     testSeparation();
+    if (!L_.separated) findLonePoints();
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
@@ -96,9 +97,15 @@ void levelPlanner<D>::findCoefficientRuns()
 {
     const int per = omegaPerNode_;
     const std::int64_t nNodes = L_.view.size()*npt;
+    std::vector<std::uint8_t> loneNode(L_.lone.empty() ? 0 : nNodes, 0);
+    for (std::size_t q = 0; q < L_.lone.size(); ++q)
+        if (L_.lone[q])
+            detail::visitStencil(L_.controlTiles[q], ctrl_.stencilAt(q, L_.scale),
+                                 [&](std::int64_t id, int n, double) { loneNode[id*npt + n] = 1; });
     auto& runs = L_.coefficientRuns;
     for (std::int64_t n = 0; n < nNodes; ++n)
     {
+        if (!loneNode.empty() && loneNode[n]) continue;
         bool any = false;
         for (int j = 0; j < per; ++j) any = any || L_.invOmega[n*per + j] > 0;
         if (!any) continue;
@@ -106,10 +113,10 @@ void levelPlanner<D>::findCoefficientRuns()
         else runs.emplace_back(n, 1);
     }
     // (where most nodes have coefficients, one sweep over all is faster
-    // than the runs)
+    // than the runs; not over the lone points' nodes)
     std::int64_t inRuns = 0;
     for (const auto& r : runs) inRuns += r.second;
-    if (2*inRuns > nNodes) runs.assign(1, {0, nNodes});
+    if (2*inRuns > nNodes && loneNode.empty()) runs.assign(1, {0, nNodes});
 }
 
 /// This rank's tiles, the tiles of each control point's stencil (found once:
@@ -396,6 +403,36 @@ void levelPlanner<D>::testSeparation()
     L_.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
 }
 
+/// levelPlan::lone, from omega (before it is inverted). Empty when no point
+/// is lone
+template <int D>
+void levelPlanner<D>::findLonePoints()
+{
+    const std::size_t nq = ctrl_.order.size();
+    std::vector<std::uint8_t> read(nRanks_ > 1 ? L_.view.size() : 0, 0);
+    for (const auto& tiles : L_.tilesTo)
+        for (const std::int64_t id : tiles) read[id] = 1;
+    std::vector<stencil<D>> st(nq);
+    for (std::size_t q = 0; q < nq; ++q) st[q] = ctrl_.stencilAt(q, L_.scale);
+    L_.lone.assign(nq, 0);
+    std::size_t nLone = 0;
+    for (std::size_t q = 0; q < nq; ++q)
+    {
+        if ((q > 0 && st[q - 1].base == st[q].base) || (q + 1 < nq && st[q + 1].base == st[q].base)) continue;
+        const std::size_t i = ctrl_.order[q];
+        bool alone = true;
+        for (const std::int32_t id : L_.controlTiles[q]) alone = alone && !(id >= 0 && !read.empty() && read[id]);
+        detail::visitStencil(L_.controlTiles[q], st[q], [&](std::int64_t id, int n, double w) {
+            const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
+            for (int c = 0; c < omegaPerNode_; ++c)
+                alone = alone && o[c] == (omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c] ? w*w : 0.0);
+        });
+        L_.lone[q] = alone;
+        nLone += alone;
+    }
+    if (nLone == 0) L_.lone.clear();
+}
+
 /// The ghosts' stencil tiles, numbered as the tiles received from their rank
 template <int D>
 void levelPlanner<D>::findGhostTiles()
@@ -433,6 +470,7 @@ void levelPlanner<D>::fillStats()
     s.viewTiles = L.view.size();
     s.dense = L.view.dense();
     s.separated = L.separated;
+    for (const std::uint8_t l : L.lone) s.lonePoints += l;
     s.chunked = L.chunked;
     s.tree = L.tree;
     s.nodes = L.view.size()*npt;
@@ -441,7 +479,7 @@ void levelPlanner<D>::fillStats()
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
         + L.scaledResiduals.capacity()*sizeof(double)
-        + L.coefficientRuns.capacity()*sizeof(L.coefficientRuns[0]));
+        + L.coefficientRuns.capacity()*sizeof(L.coefficientRuns[0]) + L.lone.capacity());
     if (L.tree)
     {
         const treeTraffic t = treeTrafficOf(nRanks_, me_, std::size_t(L.treeValues));

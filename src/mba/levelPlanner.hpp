@@ -46,6 +46,7 @@ class levelPlanner
     void sumOmega(const std::vector<std::int64_t>& ownToView);
     void findControlTiles();
     void testSeparation();
+    void findLonePoints();
     void findGhostTiles();
     void chooseExchange();
     void findCoefficientRuns();

@@ -100,6 +100,7 @@ struct levelStats
     std::int64_t viewTiles = 0;           ///< tiles of the rank's view (own + received)
     bool dense = false;                   ///< view stored densely
     bool separated = false;               ///< no two control points share a node (phi stored directly)
+    std::int64_t lonePoints = 0;          ///< this rank's points alone at their nodes (levelPlan::lone)
     std::int64_t nodes = 0;               ///< node slots stored in the view
     std::int64_t bytes = 0;               ///< bytes of the level (view data, layouts)
     std::int64_t buckets = 0;             ///< this rank's buckets

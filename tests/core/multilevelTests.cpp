@@ -197,9 +197,31 @@ namespace {
 /// The plan fitted to v1 and then, through the plan, to v2 equals the plain
 /// method at the evaluation points and at the control points; returns the
 /// plan's level statistics
+/// The points of c whose stencil at level k (its 4^D nodes from its first
+/// node) meets no other point's: no node of theirs is any other point's
+template <int D>
+std::int64_t alonePoints(const domain<D>& dom, int k, const std::vector<point<D>>& c)
+{
+    std::vector<mba::index<D>> base;
+    for (const point<D>& x : c) base.push_back(levelStencil<D>(dom.local0(x.data()), std::ldexp(1.0, k)).base);
+    std::int64_t n = 0;
+    for (std::size_t i = 0; i < c.size(); ++i)
+    {
+        bool alone = true;
+        for (std::size_t j = 0; j < c.size() && alone; ++j)
+        {
+            bool meet = j != i;
+            for (int d = 0; d < D; ++d) meet = meet && std::abs(base[i][d] - base[j][d]) <= 3;
+            alone = !meet;
+        }
+        n += alone;
+    }
+    return n;
+}
+
 template <int D>
 std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std::vector<std::uint8_t>& mask,
-                                       const std::vector<point<D>>& e)
+                                       const std::vector<point<D>>& e, domain<D>* dom = nullptr)
 {
     params p;
     p.affine = false;
@@ -222,6 +244,7 @@ std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std
     for (std::size_t i = 0; i < got.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(refc[i], tol));
     auto st = m.stats();
     st.resize(r.levels);
+    if (dom) *dom = m.dom();
     return st;
 }
 
@@ -248,9 +271,21 @@ void separatedLevels(bool masked)
     x[0] += 0.5*st.back().h;
     c.push_back(x);
     if (masked) mask.insert(mask.end(), {1, 1, 1});
-    const std::vector<levelStats> close = equalsPlainMBA<D>(c, mask, e);
+    domain<D> dom;
+    const std::vector<levelStats> close = equalsPlainMBA<D>(c, mask, e, &dom);
     REQUIRE(close.size() >= st.size());
-    CHECK_FALSE(close[st.size() - 1].separated);
+    const int k = int(st.size()) - 1;
+    CHECK_FALSE(close[k].separated);
+    // but the points whose nodes no other point reaches are lone there (the
+    // new point's neighbours are not): phi stored from each alone, and the
+    // values above equal the plain method's
+    const std::int64_t alone = alonePoints<D>(dom, k, c);
+    INFO("points " << c.size() << ", alone at level " << k << ": " << alone);
+    CHECK(alone > std::int64_t(c.size())/2);
+    CHECK(alone < std::int64_t(c.size()) - 1);
+    CHECK(close[k].lonePoints == alone);
+    CHECK(st[k].lonePoints == 0);                   // (a separated level has no lone points)
+    for (int j = 0; j < k - 2; ++j) CHECK(close[j].lonePoints == alonePoints<D>(dom, j, c));
 }
 
 } // namespace

@@ -365,37 +365,57 @@ TEST_CASE("automatic exchange: the tree on the coarse levels that 64 slabs share
     CHECK(diff <= 1e-12*maxAbs(v));
 }
 
-TEST_CASE("levels that separate the control points: serial equals simulated ranks", "[parallel]")
+TEST_CASE("levels that separate all or most control points: serial equals simulated ranks", "[parallel]")
 {
     // two faces of a mesh, evaluation points in the volume and next to the
-    // faces (their stencils read the separated level, also across ranks)
+    // faces (their stencils read the separated level, also across ranks);
+    // close: one more point half a cell of that level from another, so that
+    // the level is not separated but most points are lone there
     const bool masked = GENERATE(false, true);
     const partition how = GENERATE(partition::slabs, partition::random);
-    const std::vector<point<3>> c = twoFaces<3>(13, 0.1, 61);
+    const bool close = GENERATE(false, true);
+    std::vector<point<3>> c = twoFaces<3>(13, 0.1, 61);
     std::vector<point<3>> e = randomPoints<3>(600, 62);
     const std::vector<point<3>> near = insideFaces<3>(c, 2, 0.003);
     e.insert(e.end(), near.begin(), near.end());
     problem pb;
     pb.p.tolerance = 1e-12;
     pb.p.bucketTiles = 8;
-    const std::vector<double> v = smoothValues<3>(c, pb.nc);
-    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
+    std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
+    int finest = 0;
     {
         // (the finest level used does separate them)
         multilevel<3> m(serial(), pb.p, pb.nc, c, mask, e);
-        std::vector<double> vm = v;
+        std::vector<double> vm = smoothValues<3>(c, pb.nc);
         const fitReport& r = m.fit(vm);
         REQUIRE(r.converged);
-        REQUIRE(m.stats()[r.levels - 1].separated);
+        finest = r.levels - 1;
+        REQUIRE(m.stats()[finest].separated);
+        if (close)
+        {
+            point<3> x = c[c.size()/2];
+            x[0] += 0.5*m.stats()[finest].h;
+            c.push_back(x);
+            if (masked) mask.insert(mask.end(), {1, 1, 1});
+        }
     }
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    std::vector<std::vector<levelStats>> st(5);
+    pb.stats = &st;
     const std::vector<double> ref = solve<3>(1, how, c, v, mask, e, pb);
+    CHECK(st[0][finest].separated == !close);
+    CHECK((st[0][finest].lonePoints > std::int64_t(c.size())/2) == close);
     for (int P : {2, 3, 5})
     {
-        INFO("ranks " << P << ", masked " << masked << ", partition " << name(how));
+        INFO("ranks " << P << ", masked " << masked << ", partition " << name(how) << ", close " << close);
         const std::vector<double> got = solve<3>(P, how, c, v, mask, e, pb);
         double diff = 0;
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
         CHECK(diff <= 1e-12*maxAbs(v));
+        // (slabs: each rank has lone points there, of tiles that no other rank reads)
+        std::int64_t lone = 0;
+        for (int r = 0; r < P; ++r) lone += st[r][finest].lonePoints;
+        if (close && how == partition::slabs) CHECK(lone > std::int64_t(c.size())/4);
     }
 }
 
