@@ -480,30 +480,21 @@ void levelApplier<D>::subtractLevel(const levelPlan<D>& L, std::vector<double>& 
 {
     const std::size_t nq = ctrl_.order.size();
     const int nc = ctrl_.nComponents;
-    if (L.separated)
-    {
-        for (std::size_t q = 0; q < nq; ++q)
-        {
-            const std::size_t i = ctrl_.order[q];
-            const double sw = stencils_[q].sumSquares();
-            for (int c = 0; c < nc; ++c) residuals[i*nc + c] -= L.scaledResiduals[q*nc + c]*sw;
-        }
-        return;
-    }
+    const std::vector<double>& rr = L.separated ? L.scaledResiduals : scaledResiduals_;
     // (the level's values first, in a pass of their own: subtracting each
     // right after its sum was stored in pieces would stall on the loads)
     levelValues_.assign(nq*nc, 0.0);
     for (std::size_t q = 0, e; q < nq; q = e)
     {
         for (e = q + 1; e < nq && stencils_[e].base == stencils_[q].base; ++e) {}
-        if (e - q >= minBlockRun)
-            evalRun<D>(L.phi.data(), nc, L.controlTiles[q], &stencils_[q], e - q, &levelValues_[q*nc]);
-        else if (!L.lone.empty() && L.lone[q])
+        if (L.separated || (!L.lone.empty() && L.lone[q]))
         {
-            // (as a separated level's: (r/sum(w^2)) sum(w^2))
+            // alone at its nodes (so in no run): (r/sum(w^2)) sum(w^2)
             const double sw = stencils_[q].sumSquares();
-            for (int c = 0; c < nc; ++c) levelValues_[q*nc + c] = scaledResiduals_[q*nc + c]*sw;
+            for (int c = 0; c < nc; ++c) levelValues_[q*nc + c] = rr[q*nc + c]*sw;
         }
+        else if (e - q >= minBlockRun)
+            evalRun<D>(L.phi.data(), nc, L.controlTiles[q], &stencils_[q], e - q, &levelValues_[q*nc]);
         else
             for (std::size_t j = q; j < e; ++j)
                 evalStencil(L.phi.data(), nc, L.controlTiles[j], stencils_[j], &levelValues_[j*nc]);

@@ -194,9 +194,6 @@ TEST_CASE("planned evaluation (flat lattice + finer levels) equals the sum of th
 
 namespace {
 
-/// The plan fitted to v1 and then, through the plan, to v2 equals the plain
-/// method at the evaluation points and at the control points; returns the
-/// plan's level statistics
 /// The points of c whose stencil at level k (its 4^D nodes from its first
 /// node) meets no other point's: no node of theirs is any other point's
 template <int D>
@@ -219,6 +216,9 @@ std::int64_t alonePoints(const domain<D>& dom, int k, const std::vector<point<D>
     return n;
 }
 
+/// The plan fitted to v1 and then, through the plan, to v2 equals the plain
+/// method at the evaluation points and at the control points; returns the
+/// plan's level statistics (and its domain in dom, when given)
 template <int D>
 std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std::vector<std::uint8_t>& mask,
                                        const std::vector<point<D>>& e, domain<D>* dom = nullptr)
