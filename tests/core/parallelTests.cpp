@@ -195,6 +195,7 @@ TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and seri
     const std::vector<double> v = smoothValues<3>(c, pb.nc);
     const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
     const std::vector<double> ref = solve<3>(1, how, c, v, mask, e, pb);
+    std::int64_t loneOnChunked = 0;    // (lone points on chunked levels: the same on direct ones)
     for (const int P : {2, 3, 5, 8, 16})
     {
         INFO("ranks " << P << ", masked " << masked << ", surface " << surface << ", partition " << name(how));
@@ -208,6 +209,8 @@ TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and seri
         int chunkedLevels = 0;
         for (const levelStats& s : st[0]) chunkedLevels += s.chunked;
         CHECK(chunkedLevels >= 4);
+        for (const auto& rank : st)
+            for (const levelStats& s : rank) loneOnChunked += s.chunked ? s.lonePoints : 0;
         std::size_t differ = 0;
         double diff = 0;
         for (std::size_t i = 0; i < ref.size(); ++i)
@@ -218,6 +221,7 @@ TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and seri
         CHECK(differ == 0);
         CHECK(diff <= 1e-12*maxAbs(v));
     }
+    CHECK(loneOnChunked > 0);
 }
 
 TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many ranks share it", "[parallel][chunks]")
