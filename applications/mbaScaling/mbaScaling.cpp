@@ -534,14 +534,15 @@ int main(int argc, char** argv)
             if (o.levels)
             {
                 std::printf("  levels of the rank receiving most: level, exchange, tiles received, ghosts received, "
-                            "messages, bytes received, own tiles, view tiles, apply s\n");
+                            "messages, bytes received, own tiles, view tiles, apply s, lone points\n");
                 for (const levelStats& s : res.busiestLevels)
-                    std::printf("  %5d %8s %8lld %8lld %4lld %10lld %8lld %8lld %9.6f\n", s.level,
+                    std::printf("  %5d %8s %8lld %8lld %4lld %10lld %8lld %8lld %9.6f %8lld\n", s.level,
                                 s.separated ? "separate" : s.tree ? "tree" : s.chunked ? "chunked" : "direct",
                                 static_cast<long long>(s.tilesReceived),
                                 static_cast<long long>(s.ghostsReceived), static_cast<long long>(s.messagesReceived),
                                 static_cast<long long>(s.bytesReceivedPerApply), static_cast<long long>(s.ownTiles),
-                                static_cast<long long>(s.viewTiles), s.seconds);
+                                static_cast<long long>(s.viewTiles), s.seconds,
+                                static_cast<long long>(s.lonePoints));
             }
             std::fflush(stdout);
         }
