@@ -163,7 +163,7 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
         for (const auto& r : L.coefficientRuns) divideByOmega(L, r.first, r.second);
     else if (L.tree) divideByOmega(L);
     storeLonePoints(L, rr);
-    subtractLevel(L, residuals);
+    subtractLevel(L, rr, residuals);
 }
 
 /// Zero delta; of a separated level only the tiles that other ranks' values
@@ -475,12 +475,14 @@ void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::in
 }
 
 /// Residuals at this rank's control points minus the level's values there
+/// (rr: the apply's r/sum(w^2), which give them at the points alone at
+/// their nodes)
 template <int D>
-void levelApplier<D>::subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals)
+void levelApplier<D>::subtractLevel(const levelPlan<D>& L, const std::vector<double>& rr,
+                                    std::vector<double>& residuals)
 {
     const std::size_t nq = ctrl_.order.size();
     const int nc = ctrl_.nComponents;
-    const std::vector<double>& rr = L.separated ? L.scaledResiduals : scaledResiduals_;
     // (the level's values first, in a pass of their own: subtracting each
     // right after its sum was stored in pieces would stall on the loads)
     levelValues_.assign(nq*nc, 0.0);

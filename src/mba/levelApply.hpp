@@ -43,7 +43,7 @@ class levelApplier
     void exchangeInTree(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L, std::int64_t first = 0, std::int64_t n = -1) const;
     void storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const;
-    void subtractLevel(const levelPlan<D>& L, std::vector<double>& residuals);
+    void subtractLevel(const levelPlan<D>& L, const std::vector<double>& rr, std::vector<double>& residuals);
 
 public:
     /// The points and domain are kept by reference: they must outlive the object

@@ -383,23 +383,34 @@ void levelPlanner<D>::findControlTiles()
     });
 }
 
-/// Separated: at every node of every own stencil, in every component the
-/// point constrains, omega (the sum over all ranks) is this point's own
-/// w^2 alone, summed as the plan summed it (0 + w*w: exact), also at nodes
-/// where its weight is 0 (a coarse level fails at its first points)
+/// Whether own point q (stencil st) is alone at every node of its stencil:
+/// in every component it constrains, omega (the sum over all ranks, not yet
+/// inverted) is its own w^2 alone, summed as the plan summed it (0 + w*w:
+/// exact), also at nodes where its weight is 0; with freeZero, omega is 0
+/// in the components it leaves free
+template <int D>
+bool levelPlanner<D>::aloneAtNodes(std::size_t q, const stencil<D>& st, bool freeZero) const
+{
+    const std::size_t i = ctrl_.order[q];
+    bool alone = true;
+    detail::visitStencil(L_.controlTiles[q], st, [&](std::int64_t id, int n, double w) {
+        const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
+        for (int c = 0; c < omegaPerNode_; ++c)
+        {
+            const bool constrained = omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c];
+            if (constrained || freeZero) alone = alone && o[c] == (constrained ? w*w : 0.0);
+        }
+    });
+    return alone;
+}
+
+/// Separated: every own point of every rank is alone at its nodes in the
+/// components it constrains (a coarse level fails at its first points)
 template <int D>
 void levelPlanner<D>::testSeparation()
 {
     bool alone = true;
-    for (std::size_t q = 0; q < ctrl_.order.size() && alone; ++q)
-    {
-        const std::size_t i = ctrl_.order[q];
-        detail::visitStencil(L_.controlTiles[q], ctrl_.stencilAt(q, L_.scale), [&](std::int64_t id, int n, double w) {
-            const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
-            for (int c = 0; c < omegaPerNode_; ++c)
-                if (omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c]) alone = alone && o[c] == w*w;
-        });
-    }
+    for (std::size_t q = 0; q < ctrl_.order.size() && alone; ++q) alone = aloneAtNodes(q, ctrl_.stencilAt(q, L_.scale), false);
     L_.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
 }
 
@@ -419,14 +430,9 @@ void levelPlanner<D>::findLonePoints()
     for (std::size_t q = 0; q < nq; ++q)
     {
         if ((q > 0 && st[q - 1].base == st[q].base) || (q + 1 < nq && st[q + 1].base == st[q].base)) continue;
-        const std::size_t i = ctrl_.order[q];
         bool alone = true;
         for (const std::int32_t id : L_.controlTiles[q]) alone = alone && !(id >= 0 && !read.empty() && read[id]);
-        detail::visitStencil(L_.controlTiles[q], st[q], [&](std::int64_t id, int n, double w) {
-            const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
-            for (int c = 0; c < omegaPerNode_; ++c)
-                alone = alone && o[c] == (omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c] ? w*w : 0.0);
-        });
+        alone = alone && aloneAtNodes(q, st[q], true);
         L_.lone[q] = alone;
         nLone += alone;
     }

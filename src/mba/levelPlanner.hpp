@@ -45,6 +45,7 @@ class levelPlanner
     void assembleView();
     void sumOmega(const std::vector<std::int64_t>& ownToView);
     void findControlTiles();
+    bool aloneAtNodes(std::size_t q, const stencil<D>& st, bool freeZero) const;
     void testSeparation();
     void findLonePoints();
     void findGhostTiles();
