@@ -181,10 +181,24 @@ void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, con
 template <int D>
 int flatEvaluator<D>::chooseFlatLevel(int nLevels) const
 {
-    const double budget = double(std::max<std::size_t>(eval_.size(), 4096));
     int m = -1;
-    while (m + 1 < nLevels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
+    while (m + 1 < nLevels && boxNodes<D>(evalNodeBox(m + 1)) <= flatBudget()) ++m;
     return m;
+}
+
+/// The most nodes a flat lattice has: as many as there are evaluation
+/// points, at least 4096
+template <int D>
+double flatEvaluator<D>::flatBudget() const
+{
+    return double(std::max<std::size_t>(eval_.size(), 4096));
+}
+
+template <int D>
+bool flatEvaluator<D>::readByStencilsOnly(int k) const
+{
+    // (the boxes grow with k: no flat lattice is at or above a level whose box exceeds the budget)
+    return eval_.size() == 0 || boxNodes<D>(evalNodeBox(k)) > flatBudget();
 }
 
 /// flatPhi_: the affine approximation and levels 0..m, refined to level m

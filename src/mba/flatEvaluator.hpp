@@ -45,6 +45,7 @@ class flatEvaluator
     mutable hugeVector<double> sweptValues_;
 
     indexBox<D> evalNodeBox(int k) const;
+    double flatBudget() const;
     int chooseFlatLevel(int nLevels) const;
     void foldLevels(const std::deque<levelPlan<D>>& levels, int m, const affineFit<D>& affine);
     void addAffine(const indexBox<D>& b, const affineFit<D>& affine);
@@ -71,6 +72,11 @@ public:
     /// Whether a node of L with coefficients lies in the stencil of one of
     /// this rank's evaluation points, in a component the points' mask reads
     bool reads(const levelPlan<D>& L) const;
+
+    /// Whether level k is finer than any flat lattice (its node box holds
+    /// more nodes than the budget): then only the evaluation points'
+    /// stencils read it, never its whole tiles
+    bool readByStencilsOnly(int k) const;
 
     /// Whether there is a flat lattice (else evaluate() does not apply)
     bool active() const { return flatLevel_ >= 0; }

@@ -39,6 +39,29 @@ queryClusters<D> clusterQueryPoints(const communicator& comm, const controlPoint
 
 namespace {
 
+/// The nodes of tile t (one of the stencil's tiles) that the stencil
+/// covers, as bits (bit n: node n of the tile, the last direction fastest)
+template <int D>
+std::uint64_t stencilNodesIn(const stencil<D>& st, const index<D>& t)
+{
+    // per direction the covered nodes of a row (4 bits: from the stencil's
+    // first node on in its first tile, up to its last in the next), spread
+    // out to the direction's stride and multiplied in: the bits of the
+    // directions' rows never overlap, so the products carry nothing
+    std::uint64_t bits = 1;
+    int stride = 1;
+    for (int d = D - 1; d >= 0; --d)
+    {
+        const int o = int(st.base[d] % tileEdge);
+        const unsigned row = t[d] == st.base[d]/tileEdge ? (0xFu << o) & 0xFu : (1u << o) - 1;
+        std::uint64_t spread = 0;
+        for (int j = 0; j < tileEdge; ++j) spread |= std::uint64_t(row >> j & 1) << (j*stride);
+        bits *= spread;
+        stride *= tileEdge;
+    }
+    return bits;
+}
+
 /// An empty index box that any box's add makes that box
 template <int D>
 indexBox<D> emptyIndexBox()
@@ -215,57 +238,72 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
     std::vector<std::vector<std::uint64_t>> requests(nRanks_);
     std::vector<hashMap> requested(nRanks_);
     std::vector<std::size_t> hits;
-    std::vector<std::uint64_t> clusterTiles;
+    std::vector<std::uint64_t> clusterTiles, clusterNodes;
+    constexpr std::uint64_t allNodes = npt == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << npt) - 1;
     for (std::size_t g = 0; g < qt.size() && !remote.empty(); ++g)
     {
         hits.clear();
         for (std::size_t b = 0; b < remote.size(); ++b) if (remote[b].intersects(qt[g])) hits.push_back(b);
         if (hits.empty()) continue;
         // the cluster's stencil tiles, each once, in the order first met
-        // (the points of a cluster share most of their tiles)
+        // (the points of a cluster share most of their tiles), and the
+        // nodes of each that the stencils read (all where not stencilReads_)
         hashMap seen;
         clusterTiles.clear();
+        clusterNodes.clear();
         for (const double* x : clusters_.points[g])
         {
             const point<D> u = scaled<D>(dom_.local0(x), L_.scale);
-            forEachIndex<D>(stencil<D>(u.data()).tiles(), [&](const index<D>& t) {
+            const stencil<D> st(u.data());
+            forEachIndex<D>(st.tiles(), [&](const index<D>& t) {
                 const std::uint64_t key = L_.ownLayout.key(t);
                 const std::size_t before = seen.size();
-                seen.insert(key, 0);
-                if (seen.size() != before) clusterTiles.push_back(key);
+                const std::size_t at = seen.insert(key, before);
+                if (seen.size() != before)
+                {
+                    clusterTiles.push_back(key);
+                    clusterNodes.push_back(0);
+                }
+                clusterNodes[at] |= stencilReads_ ? stencilNodesIn<D>(st, t) : allNodes;
             });
         }
-        for (const std::uint64_t key : clusterTiles)
+        for (std::size_t c = 0; c < clusterTiles.size(); ++c)
         {
+            const std::uint64_t key = clusterTiles[c];
             const index<D> t = L_.ownLayout.coord(key);
             for (const std::size_t b : hits)
             {
                 if (!remote[b].contains(t)) continue;
                 const int r = remoteRank[b];
                 const std::size_t before = requested[r].size();
-                requested[r].insert(key, 0);
-                if (requested[r].size() != before) requests[r].push_back(key);
+                const std::size_t at = requested[r].insert(key, before);
+                if (requested[r].size() != before) requests[r].insert(requests[r].end(), {key, 0});
+                requests[r][2*at + 1] |= clusterNodes[c];
             }
         }
     }
     return requests;
 }
 
-/// The own tiles other ranks asked for (wanted: per rank its keys): their
-/// ids (tilesTo, own ids for now), and their keys and partial omega sent
+/// The own tiles other ranks asked for (wanted: per rank its keys, each
+/// followed by the nodes it reads there): their ids (tilesTo, own ids for
+/// now) and nodes (nodesTo_), and their keys and partial omega sent
 template <int D>
 void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted)
 {
     std::vector<std::vector<std::uint64_t>> keys(nRanks_);
     std::vector<std::vector<double>> om(nRanks_);
+    nodesTo_.assign(nRanks_, {});
     const int blk = npt*omegaPerNode_;
     for (int r = 0; r < nRanks_; ++r)
     {
-        for (const std::uint64_t key : wanted[r])
+        for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
         {
+            const std::uint64_t key = wanted[r][j];
             const std::int64_t id = L_.ownLayout.findKey(key);
             if (id < 0) continue;
             L_.tilesTo[r].push_back(id);
+            nodesTo_[r].push_back(wanted[r][j + 1]);
             keys[r].push_back(key);
             om[r].insert(om[r].end(), ownOmega_.begin() + id*blk, ownOmega_.begin() + (id + 1)*blk);
         }
@@ -274,25 +312,47 @@ void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t
     omegaFrom_ = comm_.exchange(om);
 }
 
-/// Ghost mode towards r when this rank's points that touch the tiles r
+/// Ghost mode towards r when this rank's points that touch the nodes r
 /// asked for cost less per apply (nc values each) than the tiles (npt*nc):
-/// their coordinates and mask flags are sent once
+/// their coordinates and mask flags are sent once. (r then forms this
+/// rank's partial sums at those nodes only; it reads no other of the tiles.)
 template <int D>
 void levelPlanner<D>::chooseGhosts()
 {
     L_.ghostsTo.assign(nRanks_, {});
     std::vector<std::vector<double>> gx(nRanks_);
-    std::vector<std::uint8_t> asked(nOwn_);
+    std::vector<std::uint64_t> asked(nOwn_);
     for (int r = 0; r < nRanks_; ++r)
     {
         if (L_.tilesTo[r].empty()) continue;
         std::fill(asked.begin(), asked.end(), 0);
-        for (const std::int64_t id : L_.tilesTo[r]) asked[id] = 1;
+        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j) asked[L_.tilesTo[r][j]] = nodesTo_[r][j];
+        // (a point that touches an asked tile but none of its asked nodes
+        // adds nothing r reads: left out, but for one if no other is left,
+        // so that r receives residuals and not the tiles)
+        std::size_t first = ctrl_.order.size();
+        const auto touches = [&](std::size_t q) {
+            bool tile = false, node = false;
+            for (const std::int32_t id : ownIds_[q]) tile = tile || (id >= 0 && asked[id]);
+            if (!tile) return false;
+            first = std::min(first, q);
+            const stencil<D> st = ctrl_.stencilAt(q, L_.scale);
+            const indexBox<D> tb = st.tiles();
+            for (int c = 0; c < (1 << D) && !node; ++c)    // (the tiles as findTiles lists them)
+            {
+                const std::int32_t id = ownIds_[q][c];
+                if (id < 0 || !asked[id]) continue;
+                index<D> t;
+                for (int d = 0; d < D; ++d) t[d] = tb.lo[d] + ((c >> (D - 1 - d)) & 1);
+                node = (asked[id] & stencilNodesIn<D>(st, t)) != 0;
+            }
+            return node;
+        };
         std::vector<std::uint32_t> g;
         std::vector<std::size_t> at;   // each ghost's position in order
         for (std::size_t q = 0; q < ctrl_.order.size(); ++q)
-            for (const std::int32_t id : ownIds_[q])
-                if (id >= 0 && asked[id]) { g.push_back(ctrl_.order[q]); at.push_back(q); break; }
+            if (touches(q)) { g.push_back(ctrl_.order[q]); at.push_back(q); }
+        if (g.empty() && first < ctrl_.order.size()) { g.push_back(ctrl_.order[first]); at.push_back(first); }
         if (g.size() >= std::size_t(npt)*L_.tilesTo[r].size()) continue;
         for (std::size_t k = 0; k < g.size(); ++k)
         {
@@ -537,16 +597,17 @@ void levelPlanner<D>::fillStats()
 
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
+                       bool stencilReads)
 {
-    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode).run(k);
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode, stencilReads).run(k);
 }
 
 template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
 template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
-                                   const queryClusters<2>&, int, params::exchangeMode);
+                                   const queryClusters<2>&, int, params::exchangeMode, bool);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
-                                   const queryClusters<3>&, int, params::exchangeMode);
+                                   const queryClusters<3>&, int, params::exchangeMode, bool);
 
 } // namespace mba

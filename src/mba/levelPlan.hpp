@@ -10,8 +10,11 @@
 // owner's control points that touch the asked tiles are fewer than the
 // tiles' nodes, it sends their coordinates once and their residuals per
 // apply instead ("ghosts"), and the asking rank forms the owner's partial
-// sums itself. A level is "separated" when no two control points share a
-// node: every node's phi then comes from one point alone.
+// sums itself: on a level that only stencils read (finer than the asking
+// rank's flat lattice) the asking rank also says which nodes of the tiles
+// its stencils read, and the ghosts are the points that reach those nodes.
+// A level is "separated" when no two control points share a node: every
+// node's phi then comes from one point alone.
 #ifndef MBA_LEVELPLAN_HPP
 #define MBA_LEVELPLAN_HPP
 
@@ -153,10 +156,12 @@ levelPlan<D> unreadLevel(const levelPlan<D>& L)
     return u;
 }
 
-/// Plans level k. Collective.
+/// Plans level k. Collective. stencilReads: only the stencils of this
+/// rank's query points read the level (flatEvaluator::readByStencilsOnly)
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode);
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
+                       bool stencilReads);
 
 } // namespace mba
 #endif

@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <set>
+
 
 using namespace mba;
 using namespace bsmTest;
@@ -530,6 +532,84 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
         INFO("rank " << r << " receives " << recv[r] << " of " << serialNodes << " finest-level nodes");
         CHECK(recv[r] < serialNodes/4);
         CHECK(gatherAll[r] > 0);
+    }
+}
+
+TEST_CASE("a rank receives as ghosts only the points that reach nodes it reads", "[parallel]")
+{
+    // The surface of the test below on 4 slabs. On a level that only
+    // stencils read (finer than every rank's flat lattice), a rank receives
+    // the other ranks' points whose stencils reach a node that its own
+    // points' stencils (control and evaluation points) read, not every point
+    // that reaches a tile it reads; counted here node by node. Levels 5 and
+    // 6: a rank's 2000 evaluation points fold levels up to 4 into its flat
+    // lattice (at most 4096 nodes), and levels 5 and 6 have points that
+    // reach the tiles but not the nodes.
+    const auto c = surfacePoints<3>(40);
+    const auto e = randomPoints<3>(8000, 111);
+    const auto v = smoothValues<3>(c, 3);
+    params p;
+    p.tolerance = 1e-8;
+    p.maxLevels = 9;
+    p.exchange = params::exchangeMode::direct;
+    const int P = 4;
+    const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);
+    std::vector<std::vector<levelStats>> st(P);
+    domain<3> dom;
+    runSimulated(P, [&](const communicator& comm) {
+        std::vector<point<3>> cl, el;
+        std::vector<double> vl;
+        for (std::size_t i = 0; i < c.size(); ++i)
+            if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
+        for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
+        multilevel<3> m(comm, p, 3, cl, {}, el);
+        m.fit(vl);
+        st[comm.rank()] = m.stats();
+        if (comm.rank() == 0) dom = m.dom();
+    });
+    auto key = [](std::int64_t i, std::int64_t j, std::int64_t l) { return (i*100003 + j)*100019 + l; };
+    for (const int k : {5, 6})
+    {
+        REQUIRE(int(st[0].size()) > k);
+        const double s = std::ldexp(1.0, k);
+        auto base = [&](const point<3>& x) {
+            const point<3> u = dom.local0(x.data());
+            return std::array<std::int64_t, 3>{{std::int64_t(u[0]*s), std::int64_t(u[1]*s), std::int64_t(u[2]*s)}};
+        };
+        // f(node key, tile key) for each node of x's stencil
+        auto forStencil = [&](const point<3>& x, auto f) {
+            const auto b = base(x);
+            for (int a0 = 0; a0 < 4; ++a0)
+                for (int a1 = 0; a1 < 4; ++a1)
+                    for (int a2 = 0; a2 < 4; ++a2)
+                    {
+                        const std::int64_t i = b[0] + a0, j = b[1] + a1, l = b[2] + a2;
+                        f(key(i, j, l), key(i/tileEdge, j/tileEdge, l/tileEdge));
+                    }
+        };
+        std::int64_t tileOnly = 0;   // points reaching a tile read, none of its nodes read
+        for (int r = 0; r < P; ++r)
+        {
+            std::set<std::int64_t> nodes, tiles;
+            const auto add = [&](std::int64_t n, std::int64_t t) { nodes.insert(n); tiles.insert(t); };
+            for (std::size_t i = 0; i < c.size(); ++i) if (rc[i] == r) forStencil(c[i], add);
+            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == r) forStencil(e[i], add);
+            std::int64_t reaching = 0;
+            for (std::size_t i = 0; i < c.size(); ++i)
+            {
+                if (rc[i] == r) continue;
+                bool node = false, tile = false;
+                forStencil(c[i], [&](std::int64_t n, std::int64_t t) {
+                    node = node || nodes.count(n) > 0;
+                    tile = tile || tiles.count(t) > 0;
+                });
+                reaching += node;
+                tileOnly += tile && !node;
+            }
+            INFO("level " << k << ", rank " << r);
+            CHECK(st[r][k].ghostsReceived == reaching);
+        }
+        CHECK(tileOnly > 0);
     }
 }
 
