@@ -535,9 +535,46 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
     }
 }
 
+namespace {
+
+/// A surface (points on the cube's faces, the morphing case) and scattered
+/// evaluation points on P slabs along x, fitted with the direct exchange:
+/// which rank holds each point, and each rank's levels
+struct surfaceOnSlabs
+{
+    const std::vector<point<3>> c = surfacePoints<3>(40), e = randomPoints<3>(8000, 111);
+    const std::vector<int> rc, re;
+    std::vector<std::vector<levelStats>> stats;
+    domain<3> dom;
+
+    explicit surfaceOnSlabs(int P)
+    :
+        rc(ranksOf<3>(c, P, partition::slabs, 1)), re(ranksOf<3>(e, P, partition::slabs, 2)), stats(P)
+    {
+        const auto v = smoothValues<3>(c, 3);
+        params p;
+        p.tolerance = 1e-8;
+        p.maxLevels = 9;
+        p.exchange = params::exchangeMode::direct;
+        runSimulated(P, [&](const communicator& comm) {
+            std::vector<point<3>> cl, el;
+            std::vector<double> vl;
+            for (std::size_t i = 0; i < c.size(); ++i)
+                if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
+            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
+            multilevel<3> m(comm, p, 3, cl, {}, el);
+            m.fit(vl);
+            stats[comm.rank()] = m.stats();
+            if (comm.rank() == 0) dom = m.dom();
+        });
+    }
+};
+
+} // namespace
+
 TEST_CASE("a rank receives as ghosts only the points that reach nodes it reads", "[parallel]")
 {
-    // The surface of the test below on 4 slabs. On a level that only
+    // A surface on 4 slabs (surfaceOnSlabs). On a level that only
     // stencils read (finer than every rank's flat lattice), a rank receives
     // the other ranks' points whose stencils reach a node that its own
     // points' stencils (control and evaluation points) read, not every point
@@ -545,28 +582,14 @@ TEST_CASE("a rank receives as ghosts only the points that reach nodes it reads",
     // 6: a rank's 2000 evaluation points fold levels up to 4 into its flat
     // lattice (at most 4096 nodes), and levels 5 and 6 have points that
     // reach the tiles but not the nodes.
-    const auto c = surfacePoints<3>(40);
-    const auto e = randomPoints<3>(8000, 111);
-    const auto v = smoothValues<3>(c, 3);
-    params p;
-    p.tolerance = 1e-8;
-    p.maxLevels = 9;
-    p.exchange = params::exchangeMode::direct;
     const int P = 4;
-    const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);
-    std::vector<std::vector<levelStats>> st(P);
-    domain<3> dom;
-    runSimulated(P, [&](const communicator& comm) {
-        std::vector<point<3>> cl, el;
-        std::vector<double> vl;
-        for (std::size_t i = 0; i < c.size(); ++i)
-            if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
-        for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
-        multilevel<3> m(comm, p, 3, cl, {}, el);
-        m.fit(vl);
-        st[comm.rank()] = m.stats();
-        if (comm.rank() == 0) dom = m.dom();
-    });
+    const surfaceOnSlabs run(P);
+    const auto& c = run.c;
+    const auto& e = run.e;
+    const auto& rc = run.rc;
+    const auto& re = run.re;
+    const auto& st = run.stats;
+    const domain<3>& dom = run.dom;
     auto key = [](std::int64_t i, std::int64_t j, std::int64_t l) { return (i*100003 + j)*100019 + l; };
     for (const int k : {5, 6})
     {
@@ -615,28 +638,10 @@ TEST_CASE("a rank receives as ghosts only the points that reach nodes it reads",
 
 TEST_CASE("fine levels exchange ghost residuals, not tiles; coarse levels tiles", "[parallel]")
 {
-    // A surface (points on the cube's faces, the morphing case), slabs along x
-    const auto c = surfacePoints<3>(40);
-    const auto e = randomPoints<3>(8000, 111);
-    const auto v = smoothValues<3>(c, 3);
-    params p;
-    p.tolerance = 1e-8;
-    p.maxLevels = 9;
-    p.exchange = params::exchangeMode::direct;
+    // A surface on slabs (surfaceOnSlabs)
     for (const int P : {2, 4, 8})
     {
-        const auto rc = ranksOf<3>(c, P, partition::slabs, 1), re = ranksOf<3>(e, P, partition::slabs, 2);
-        std::vector<std::vector<levelStats>> st(P);
-        runSimulated(P, [&](const communicator& comm) {
-            std::vector<point<3>> cl, el;
-            std::vector<double> vl;
-            for (std::size_t i = 0; i < c.size(); ++i)
-                if (rc[i] == comm.rank()) { cl.push_back(c[i]); vl.insert(vl.end(), &v[3*i], &v[3*i] + 3); }
-            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == comm.rank()) el.push_back(e[i]);
-            multilevel<3> m(comm, p, 3, cl, {}, el);
-            m.fit(vl);
-            st[comm.rank()] = m.stats();
-        });
+        const std::vector<std::vector<levelStats>> st = surfaceOnSlabs(P).stats;
         int finestReceivers = 0;
         for (int r = 0; r < P; ++r)
         {
