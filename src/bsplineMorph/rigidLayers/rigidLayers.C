@@ -30,6 +30,7 @@ License
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
@@ -363,7 +364,12 @@ void Foam::rigidLayers::fitRotations
     patchRotation_.setSize(patchIDs_.size());
     forAll(patchSum, k)
     {
-        patchRotation_[k] = rotation(patchSum[k]);
+        patchRotation_[k] = rotationOf(patchSum[k], k, knownPatchSum_, knownPatchRotation_);
+    }
+    if (known)
+    {
+        knownPatchSum_ = patchSum;
+        knownPatchRotation_ = patchRotation_;
     }
     // The sums of the ranks that share a point, the same on all of them
     wallSum_->sum(rotation_);
@@ -406,10 +412,33 @@ void Foam::rigidLayers::fitRotations
         }
     };
     power(rotation_, nSmooth_, smoothCoeffs_, sweep, smoothWork_);
-    for (tensor& R : rotation_)
+    const tensorField matrices(known ? rotation_ : tensorField());
+    forAll(rotation_, wi)
     {
-        R = rotation(R);
+        rotation_[wi] = rotationOf(rotation_[wi], wi, knownMatrix_, knownRotation_);
     }
+    if (known)
+    {
+        knownMatrix_ = matrices;
+        knownRotation_ = rotation_;
+    }
+}
+
+
+Foam::tensor Foam::rigidLayers::rotationOf
+(
+    const tensor& M,
+    const label i,
+    const tensorField& matrices,
+    const tensorField& rotations
+)
+{
+    // (bit for bit: rotation() of the same bits gives the same bits)
+    if (i < rotations.size() && std::memcmp(&M, &matrices[i], sizeof(tensor)) == 0)
+    {
+        return rotations[i];
+    }
+    return rotation(M);
 }
 
 
