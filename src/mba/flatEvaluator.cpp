@@ -296,12 +296,12 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     return read;
 }
 
-/// The weighted sum of 1/omega over the stencil at level L of the
-/// evaluation point at position q of the sweep, in w (per component, or
-/// w[0] for all when a node holds one omega): the weights are >= 0, so it
-/// is > 0 exactly where a node of non-zero weight has coefficients. False
-/// when no tile of L's view meets the stencil (nor does any finer level's:
-/// their nodes lie within the stencils of the same control points).
+/// Whether a node of positive weight in the stencil at level L of the
+/// evaluation point at position q of the sweep has coefficients, per omega
+/// value (per component, or w[0] for all when a node holds one omega): w
+/// 1 where one has, else 0. False when no tile of L's view meets the
+/// stencil (nor does any finer level's: their nodes lie within the stencils
+/// of the same control points).
 template <int D>
 bool flatEvaluator<D>::coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid,
                                           double w[3]) const
@@ -309,7 +309,15 @@ bool flatEvaluator<D>::coefficientWeights(const levelPlan<D>& L, std::size_t q, 
     const stencil<D> st = levelStencil<D>(eval_.u0[q], L.scale);
     w[0] = w[1] = w[2] = 0;
     if (!findTiles(L.view, st, tid)) return false;
-    evalStencil(L.invOmega.data(), ctrl_.omegaPerNode, tid, st, w);
+    const int per = ctrl_.omegaPerNode;
+    const indexBox<D> tb = st.tiles();
+    for (int c = 0; c < (1 << D); ++c)
+    {
+        if (tid[c] < 0) continue;
+        const std::uint64_t nodes = st.nodesIn(stencilTile<D>(tb, c), true);
+        for (int j = 0; j < per; ++j)
+            if (L.coefficientNodes[std::size_t(tid[c])*per + j] & nodes) w[j] = 1;
+    }
     return true;
 }
 

@@ -15,6 +15,7 @@
 #include "hashMap.hpp"
 
 #include <cmath>
+#include <cstdint>
 
 namespace mba {
 
@@ -158,7 +159,42 @@ template <int D> struct stencil
         }
         return b;
     }
+
+    /// The nodes of tile t that the stencil covers (positive: only those of
+    /// positive weight), as bits: bit n for node n of the tile, the last
+    /// direction fastest
+    std::uint64_t nodesIn(const index<D>& t, bool positive = false) const
+    {
+        // per direction the covered nodes of a row of the tile, spread out
+        // to the direction's stride and multiplied in (the rows' bits never
+        // overlap: the products carry nothing)
+        std::uint64_t bits = 1;
+        int stride = 1;
+        for (int d = D - 1; d >= 0; --d)
+        {
+            std::uint64_t spread = 0;
+            for (int j = 0; j < tileEdge; ++j)
+            {
+                const std::int64_t i = t[d]*tileEdge + j - base[d];
+                if (i >= 0 && i < 4 && (!positive || w[d][i] > 0)) spread |= std::uint64_t(1) << (j*stride);
+            }
+            bits *= spread;
+            stride *= tileEdge;
+        }
+        return bits;
+    }
 };
+
+/// Tile c of a stencil's tiles (box: stencil::tiles()): entry c of
+/// stencilTiles; may lie beyond the box (no such tile) along a direction
+/// where the stencil has one tile
+template <int D>
+inline index<D> stencilTile(const indexBox<D>& box, int c)
+{
+    index<D> t;
+    for (int d = 0; d < D; ++d) t[d] = box.lo[d] + ((c >> (D - 1 - d)) & 1);
+    return t;
+}
 
 /// Ids of the (up to 2^D) tiles a stencil touches, -1 where absent: entry
 /// (i*2 + j)*2 + k holds tile (t0 + i, t0 + j, t0 + k), t0 = the stencil's first tile
@@ -172,13 +208,9 @@ bool findTiles(const tileLayout<D>& L, const stencil<D>& st, stencilTiles<D>& ti
     bool any = false;
     for (int c = 0; c < (1 << D); ++c)
     {
-        index<D> t;
+        const index<D> t = stencilTile<D>(b, c);
         bool in = true;
-        for (int d = 0; d < D; ++d)
-        {
-            t[d] = b.lo[d] + ((c >> (D - 1 - d)) & 1);
-            in = in && t[d] <= b.hi[d];
-        }
+        for (int d = 0; d < D; ++d) in = in && t[d] <= b.hi[d];
         const std::int64_t id = in ? L.find(t) : -1;
         tid[c] = std::int32_t(id);
         any = any || id >= 0;

@@ -160,8 +160,15 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
     // phi = delta/omega (no contribution where omega is 0: delta is 0 there
     // too); separated levels hold phi already, chunked ones received it
     if (!L.separated && !L.chunked && !L.tree)
-        for (const auto& r : L.coefficientRuns) divideByOmega(L, r.first, r.second);
-    else if (L.tree) divideByOmega(L);
+    {
+        const double* s = L.runScales.data();
+        for (const auto& r : L.coefficientRuns)
+        {
+            divideByOmega(L, r.first, r.second, s);
+            s += r.second*ctrl_.omegaPerNode;
+        }
+    }
+    else if (L.tree) divideByOmega(L, 0, std::int64_t(L.invOmega.size())/ctrl_.omegaPerNode, L.invOmega.data());
     storeLonePoints(L, rr);
     subtractLevel(L, rr, residuals);
 }
@@ -415,7 +422,8 @@ void levelApplier<D>::exchangeChunks(levelPlan<D>& L)
             }
         }
         std::copy(sum.begin(), sum.end(), ph);
-        divideByOmega(L, X.owned[k].tile*npt + X.owned[k].node0, X.owned[k].nodes);
+        const std::int64_t node0 = X.owned[k].tile*npt + X.owned[k].node0;
+        divideByOmega(L, node0, X.owned[k].nodes, L.invOmega.data() + node0*ctrl_.omegaPerNode);
     }
     exchange(X.fullTo, X.fullCounts);
     for (int r = 0; r < P; ++r)
@@ -457,15 +465,13 @@ void levelApplier<D>::exchangeInTree(levelPlan<D>& L)
         if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(v, v + nc, ph); });
 }
 
-/// phi = delta/omega: one 1/omega per node, or per value; of nodes
-/// [first, first + n) (default: all)
+/// phi = delta/omega at nodes [first, first + n): s their 1/omega, one per
+/// node or per value
 template <int D>
-void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::int64_t n) const
+void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::int64_t n, const double* s) const
 {
     const int nc = ctrl_.nComponents, per = ctrl_.omegaPerNode;
-    if (n < 0) n = std::int64_t(L.invOmega.size())/per;
     double* v = L.phi.data() + first*nc;
-    const double* s = L.invOmega.data() + first*per;
     switch (per == 1 ? nc : 1)
     {
         case 1: scaleNodes<1>(v, s, std::size_t(n*per)); break;

@@ -39,29 +39,6 @@ queryClusters<D> clusterQueryPoints(const communicator& comm, const controlPoint
 
 namespace {
 
-/// The nodes of tile t (one of the stencil's tiles) that the stencil
-/// covers, as bits (bit n: node n of the tile, the last direction fastest)
-template <int D>
-std::uint64_t stencilNodesIn(const stencil<D>& st, const index<D>& t)
-{
-    // per direction the covered nodes of a row (4 bits: from the stencil's
-    // first node on in its first tile, up to its last in the next), spread
-    // out to the direction's stride and multiplied in: the bits of the
-    // directions' rows never overlap, so the products carry nothing
-    std::uint64_t bits = 1;
-    int stride = 1;
-    for (int d = D - 1; d >= 0; --d)
-    {
-        const int o = int(st.base[d] % tileEdge);
-        const unsigned row = t[d] == st.base[d]/tileEdge ? (0xFu << o) & 0xFu : (1u << o) - 1;
-        std::uint64_t spread = 0;
-        for (int j = 0; j < tileEdge; ++j) spread |= std::uint64_t(row >> j & 1) << (j*stride);
-        bits *= spread;
-        stride *= tileEdge;
-    }
-    return bits;
-}
-
 /// An empty index box that any box's add makes that box
 template <int D>
 indexBox<D> emptyIndexBox()
@@ -110,8 +87,34 @@ levelPlan<D> levelPlanner<D>::run(int k)
         L_.readEveryFit.assign(ctrl_.order.size(), 1);
         L_.scaledResiduals.assign(ctrl_.order.size()*nc_, 0.0);
     }
+    keepOmega();
     fillStats();
     return std::move(L_);
+}
+
+/// What the fits and the evaluator read of 1/omega, from the full array:
+/// coefficientNodes, and on plain levels runScales, in place of the array
+/// (kept on chunked and tree levels, dropped on separated ones)
+template <int D>
+void levelPlanner<D>::keepOmega()
+{
+    const int per = omegaPerNode_;
+    L_.coefficientNodes.assign(std::size_t(L_.view.size())*per, 0);
+    for (std::int64_t id = 0; id < L_.view.size(); ++id)
+        for (int n = 0; n < npt; ++n)
+            for (int j = 0; j < per; ++j)
+                if (L_.invOmega[(id*npt + n)*per + j] > 0) L_.coefficientNodes[id*per + j] |= std::uint64_t(1) << n;
+    if (L_.chunked || L_.tree) return;
+    if (!L_.separated)
+    {
+        std::size_t n = 0;
+        for (const auto& r : L_.coefficientRuns) n += std::size_t(r.second)*per;
+        L_.runScales.assign(n, 0.0);
+        double* to = L_.runScales.data();
+        for (const auto& r : L_.coefficientRuns)
+            to = std::copy(L_.invOmega.data() + r.first*per, L_.invOmega.data() + (r.first + r.second)*per, to);
+    }
+    hugeVector<double>().swap(L_.invOmega);
 }
 
 /// levelPlan::coefficientRuns from 1/omega
@@ -264,7 +267,7 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
                     clusterTiles.push_back(key);
                     clusterNodes.push_back(0);
                 }
-                clusterNodes[at] |= stencilReads_ ? stencilNodesIn<D>(st, t) : allNodes;
+                clusterNodes[at] |= stencilReads_ ? st.nodesIn(t) : allNodes;
             });
         }
         for (std::size_t c = 0; c < clusterTiles.size(); ++c)
@@ -338,13 +341,10 @@ void levelPlanner<D>::chooseGhosts()
             first = std::min(first, q);
             const stencil<D> st = ctrl_.stencilAt(q, L_.scale);
             const indexBox<D> tb = st.tiles();
-            for (int c = 0; c < (1 << D) && !node; ++c)    // (the tiles as findTiles lists them)
+            for (int c = 0; c < (1 << D) && !node; ++c)
             {
                 const std::int32_t id = ownIds_[q][c];
-                if (id < 0 || !asked[id]) continue;
-                index<D> t;
-                for (int d = 0; d < D; ++d) t[d] = tb.lo[d] + ((c >> (D - 1 - d)) & 1);
-                node = (asked[id] & stencilNodesIn<D>(st, t)) != 0;
+                if (id >= 0 && asked[id]) node = (asked[id] & st.nodesIn(stencilTile<D>(tb, c))) != 0;
             }
             return node;
         };
@@ -541,7 +541,8 @@ void levelPlanner<D>::fillStats()
     s.tree = L.tree;
     s.nodes = L.view.size()*npt;
     // (phi as the first apply allocates it)
-    s.bytes = std::int64_t((L.coefficientCount(nc_) + L.invOmega.capacity())*sizeof(double)
+    s.bytes = std::int64_t((L.coefficientCount(nc_) + L.invOmega.capacity() + L.runScales.capacity())*sizeof(double)
+        + L.coefficientNodes.capacity()*sizeof(std::uint64_t)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()
         + L.scaledResiduals.capacity()*sizeof(double)

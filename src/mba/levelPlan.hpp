@@ -62,7 +62,14 @@ struct levelPlan
     /// whole lattice store the rest, from the last fit
     /// (storeDeferredCoefficients: a cache, not a change)
     mutable hugeVector<double> phi;
-    hugeVector<double> invOmega;    ///< 1/omega at the view's nodes (0 where omega is), omegaPerNode a node
+    /// 1/omega at the view's nodes (0 where omega is), omegaPerNode a node:
+    /// kept after the plan on chunked and tree levels only (their divides
+    /// read it; plain levels keep runScales, separated ones divide nothing)
+    hugeVector<double> invOmega;
+    /// Per view tile and omega value (omegaPerNode a tile): the nodes where
+    /// that omega is > 0 (bit n: node n of the tile), which the evaluator
+    /// asks (which components a point's stencil has coefficients in)
+    std::vector<std::uint64_t> coefficientNodes;
 
     /// No two control points (of any rank) share a node of their stencils
     /// (fine levels, where the points are farther apart than a stencil): a
@@ -114,6 +121,9 @@ struct levelPlan
     /// every fit (no control point reaches them), so an apply clears and
     /// divides these only.
     std::vector<std::pair<std::int64_t, std::int64_t>> coefficientRuns;
+    /// Plain levels: 1/omega at the nodes of coefficientRuns, run after run
+    /// (omegaPerNode a node), what the divide reads in sequence
+    hugeVector<double> runScales;
 
     /// Levels not separated: per own point in order, 1 where the point is
     /// "lone": alone at every node of its stencil (omega there is its own w^2

@@ -61,6 +61,7 @@ class levelPlanner
     double exchangeCost(int rounds, std::int64_t messages, std::int64_t bytes) const;
     double currentExchangeCost() const;
     double treeExchangeCost(std::int64_t n) const;
+    void keepOmega();
     void fillStats();
 
 public:
