@@ -207,8 +207,9 @@ Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
     }
     for (label iter = 0; iter < 100; ++iter)
     {
-        const scalar g = std::cbrt(1/det(X));
-        const tensor next = 0.5*(g*X + inv(X).T()/g);
+        const scalar detX = det(X);     // (inv(X) is inv(X, det(X)))
+        const scalar g = std::cbrt(1/detX);
+        const tensor next = 0.5*(g*X + inv(X, detX).T()/g);
         const scalar change = mag(next - X);
         X = next;
         if (change < 1e-14)
