@@ -298,8 +298,8 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
 
 /// Whether a node of positive weight in the stencil at level L of the
 /// evaluation point at position q of the sweep has coefficients, per omega
-/// value (per component, or w[0] for all when a node holds one omega): w
-/// 1 where one has, else 0. False when no tile of L's view meets the
+/// value (per component, or w[0] for all when a node holds one omega):
+/// w[j] is 1 where one has, else 0. False when no tile of L's view meets the
 /// stencil (nor does any finer level's: their nodes lie within the stencils
 /// of the same control points).
 template <int D>

@@ -62,7 +62,7 @@ struct levelPlan
     /// whole lattice store the rest, from the last fit
     /// (storeDeferredCoefficients: a cache, not a change)
     mutable hugeVector<double> phi;
-    /// 1/omega at the view's nodes (0 where omega is), omegaPerNode a node:
+    /// 1/omega at the view's nodes (0 where omega is 0), omegaPerNode a node:
     /// kept after the plan on chunked and tree levels only (their divides
     /// read it; plain levels keep runScales, separated ones divide nothing)
     hugeVector<double> invOmega;
