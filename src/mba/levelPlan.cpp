@@ -74,6 +74,7 @@ levelPlan<D> levelPlanner<D>::run(int k)
     testSeparation();
     if (!L_.separated) findLonePoints();
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
+    findCoefficientNodes();
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
@@ -92,11 +93,9 @@ levelPlan<D> levelPlanner<D>::run(int k)
     return std::move(L_);
 }
 
-/// What the fits and the evaluator read of 1/omega, from the full array:
-/// coefficientNodes, and on plain levels runScales, in place of the array
-/// (kept on chunked and tree levels, dropped on separated ones)
+/// levelPlan::coefficientNodes from 1/omega
 template <int D>
-void levelPlanner<D>::keepOmega()
+void levelPlanner<D>::findCoefficientNodes()
 {
     const int per = omegaPerNode_;
     L_.coefficientNodes.assign(std::size_t(L_.view.size())*per, 0);
@@ -104,6 +103,15 @@ void levelPlanner<D>::keepOmega()
         for (int n = 0; n < npt; ++n)
             for (int j = 0; j < per; ++j)
                 if (L_.invOmega[(id*npt + n)*per + j] > 0) L_.coefficientNodes[id*per + j] |= std::uint64_t(1) << n;
+}
+
+/// What the fits read of 1/omega after the plan: on plain levels runScales,
+/// in place of the full array (kept on chunked and tree levels, dropped on
+/// separated ones)
+template <int D>
+void levelPlanner<D>::keepOmega()
+{
+    const int per = omegaPerNode_;
     if (L_.chunked || L_.tree) return;
     if (!L_.separated)
     {
@@ -117,12 +125,17 @@ void levelPlanner<D>::keepOmega()
     hugeVector<double>().swap(L_.invOmega);
 }
 
-/// levelPlan::coefficientRuns from 1/omega
+/// levelPlan::coefficientRuns from coefficientNodes
 template <int D>
 void levelPlanner<D>::findCoefficientRuns()
 {
     const int per = omegaPerNode_;
     const std::int64_t nNodes = L_.view.size()*npt;
+    const auto coefficient = [&](std::int64_t n) {
+        std::uint64_t any = 0;
+        for (int j = 0; j < per; ++j) any |= L_.coefficientNodes[(n/npt)*per + j];
+        return (any >> (n % npt) & 1) != 0;
+    };
     std::vector<std::uint8_t> loneNode(L_.lone.empty() ? 0 : nNodes, 0);
     for (std::size_t q = 0; q < L_.lone.size(); ++q)
         if (L_.lone[q])
@@ -131,10 +144,7 @@ void levelPlanner<D>::findCoefficientRuns()
     auto& runs = L_.coefficientRuns;
     for (std::int64_t n = 0; n < nNodes; ++n)
     {
-        if (!loneNode.empty() && loneNode[n]) continue;
-        bool any = false;
-        for (int j = 0; j < per; ++j) any = any || L_.invOmega[n*per + j] > 0;
-        if (!any) continue;
+        if ((!loneNode.empty() && loneNode[n]) || !coefficient(n)) continue;
         if (!runs.empty() && runs.back().first + runs.back().second == n) ++runs.back().second;
         else runs.emplace_back(n, 1);
     }

@@ -55,6 +55,7 @@ class levelPlanner
     void findLonePoints();
     void findGhostTiles();
     void chooseExchange();
+    void findCoefficientNodes();
     void findCoefficientRuns();
     void considerTree();
     void dropDirectExchange();
