@@ -194,13 +194,6 @@ double flatEvaluator<D>::flatBudget() const
     return double(std::max<std::size_t>(eval_.size(), 4096));
 }
 
-template <int D>
-bool flatEvaluator<D>::readByStencilsOnly(int k) const
-{
-    // (the boxes grow with k: no flat lattice is at or above a level whose box exceeds the budget)
-    return eval_.size() == 0 || boxNodes<D>(evalNodeBox(k)) > flatBudget();
-}
-
 /// flatPhi_: the affine approximation and levels 0..m, refined to level m
 /// on its node box, summed
 template <int D>

@@ -73,11 +73,6 @@ public:
     /// this rank's evaluation points, in a component the points' mask reads
     bool reads(const levelPlan<D>& L) const;
 
-    /// Whether level k is finer than any flat lattice (its node box holds
-    /// more nodes than the budget): then only points' stencils read it
-    /// (the evaluation points' and the control points'), never whole tiles
-    bool readByStencilsOnly(int k) const;
-
     /// Whether there is a flat lattice (else evaluate() does not apply)
     bool active() const { return flatLevel_ >= 0; }
 

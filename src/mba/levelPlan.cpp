@@ -252,7 +252,6 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
     std::vector<hashMap> requested(nRanks_);
     std::vector<std::size_t> hits;
     std::vector<std::uint64_t> clusterTiles, clusterNodes;
-    constexpr std::uint64_t allNodes = npt == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << npt) - 1;
     for (std::size_t g = 0; g < qt.size() && !remote.empty(); ++g)
     {
         hits.clear();
@@ -260,7 +259,7 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
         if (hits.empty()) continue;
         // the cluster's stencil tiles, each once, in the order first met
         // (the points of a cluster share most of their tiles), and the
-        // nodes of each that the stencils read (all where not stencilReads_)
+        // nodes of each that the stencils read
         hashMap seen;
         clusterTiles.clear();
         clusterNodes.clear();
@@ -277,7 +276,7 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
                     clusterTiles.push_back(key);
                     clusterNodes.push_back(0);
                 }
-                clusterNodes[at] |= stencilReads_ ? st.nodesIn(t) : allNodes;
+                clusterNodes[at] |= st.nodesIn(t);
             });
         }
         for (std::size_t c = 0; c < clusterTiles.size(); ++c)
@@ -608,17 +607,16 @@ void levelPlanner<D>::fillStats()
 
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
-                       bool stencilReads)
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
 {
-    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode, stencilReads).run(k);
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode).run(k);
 }
 
 template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
 template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
-                                   const queryClusters<2>&, int, params::exchangeMode, bool);
+                                   const queryClusters<2>&, int, params::exchangeMode);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
-                                   const queryClusters<3>&, int, params::exchangeMode, bool);
+                                   const queryClusters<3>&, int, params::exchangeMode);
 
 } // namespace mba

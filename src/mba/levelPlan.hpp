@@ -10,9 +10,13 @@
 // owner's control points that touch the asked tiles are fewer than the
 // tiles' nodes, it sends their coordinates once and their residuals per
 // apply instead ("ghosts"), and the asking rank forms the owner's partial
-// sums itself: on a level that only stencils read (finer than the asking
-// rank's flat lattice) the asking rank also says which nodes of the tiles
-// its stencils read, and the ghosts are the points that reach those nodes.
+// sums itself. The asking rank also says which nodes of the tiles its
+// stencils read, and the ghosts are the points that reach those nodes: its
+// other nodes of the tiles then hold part of the sum, which no point reads.
+// (The flat lattice refines them too, but a refined node that a point's
+// stencil weighs by w > 0 takes only coarse nodes whose basis is positive
+// at the point, the subdivision's weights and the basis being non-negative:
+// nodes of the point's coarse stencil, which hold the whole sum.)
 // A level is "separated" when no two control points share a node: every
 // node's phi then comes from one point alone.
 #ifndef MBA_LEVELPLAN_HPP
@@ -166,12 +170,10 @@ levelPlan<D> unreadLevel(const levelPlan<D>& L)
     return u;
 }
 
-/// Plans level k. Collective. stencilReads: only the stencils of this
-/// rank's query points read the level (flatEvaluator::readByStencilsOnly)
+/// Plans level k. Collective
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
-                       bool stencilReads);
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode);
 
 } // namespace mba
 #endif

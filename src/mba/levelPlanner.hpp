@@ -24,9 +24,6 @@ class levelPlanner
     const queryClusters<D>& clusters_;  ///< this rank's query points (parallel only)
     const int bucketTiles_;             ///< target tiles per bucket (params::bucketTiles)
     const params::exchangeMode mode_;   ///< how the partial sums meet (params::exchange)
-    /// Only the stencils of this rank's query points read the level (no
-    /// flat lattice takes its whole tiles): it asks for their nodes alone
-    const bool stencilReads_;
     const int nRanks_, me_;             ///< the communicator's size and this rank
     const int nc_, omegaPerNode_;       ///< values a point, omega values a node (as ctrl_'s)
 
@@ -67,10 +64,9 @@ class levelPlanner
 
 public:
     levelPlanner(const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                 const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode, bool stencilReads)
+                 const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
     :
         comm_(comm), dom_(dom), ctrl_(ctrl), clusters_(clusters), bucketTiles_(bucketTiles), mode_(mode),
-        stencilReads_(stencilReads),
         nRanks_(comm.size()), me_(comm.rank()), nc_(ctrl.nComponents), omegaPerNode_(ctrl.omegaPerNode)
     {}
 

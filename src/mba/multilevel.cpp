@@ -251,7 +251,7 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         {
             const double t1 = now();
             s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
-                                            s.parameters.exchange, s.evaluator.readByStencilsOnly(k)));
+                                            s.parameters.exchange));
             levelPlan<D>& L = s.levels.back();
             if (s.parameters.stopUnread && !(s.comm.max(s.evaluator.reads(L) ? 1.0 : 0.0) > 0)) L = unreadLevel(L);
             L.stats.planSeconds = now() - t1;
