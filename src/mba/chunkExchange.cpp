@@ -24,6 +24,7 @@ struct tileTable
 {
     std::vector<std::int64_t> cBegin, rBegin;
     std::vector<int> contributors, readers;
+    std::vector<std::uint64_t> readerNodes;   ///< the nodes each reader reads
     std::vector<std::int64_t> where;
     std::vector<std::int64_t> byKey;
 };
@@ -44,11 +45,12 @@ tileTable makeTileTable(const chunkSources<D>& in)
                 for (std::size_t t = 0; t < in.tilesFrom[r].size(); ++t) f(in.tilesFrom[r][t], r, std::int64_t(t));
         }
     };
-    auto forReaders = [&](const std::function<void(std::int64_t, int)>& f) {
-        for (int r = 0; r < in.nRanks; ++r) for (const std::int64_t id : in.tilesTo[r]) f(id, r);
+    auto forReaders = [&](const std::function<void(std::int64_t, int, std::uint64_t)>& f) {
+        for (int r = 0; r < in.nRanks; ++r)
+            for (std::size_t t = 0; t < in.tilesTo[r].size(); ++t) f(in.tilesTo[r][t], r, in.readTo[r][t]);
     };
     forContributors([&](std::int64_t id, int, std::int64_t) { ++T.cBegin[id + 1]; });
-    forReaders([&](std::int64_t id, int) { ++T.rBegin[id + 1]; });
+    forReaders([&](std::int64_t id, int, std::uint64_t) { ++T.rBegin[id + 1]; });
     for (std::int64_t id = 0; id < nView; ++id)
     {
         T.cBegin[id + 1] += T.cBegin[id];
@@ -57,12 +59,16 @@ tileTable makeTileTable(const chunkSources<D>& in)
     T.contributors.resize(T.cBegin[nView]);
     T.where.resize(T.cBegin[nView]);
     T.readers.resize(T.rBegin[nView]);
+    T.readerNodes.resize(T.rBegin[nView]);
     std::vector<std::int64_t> cAt(T.cBegin.begin(), T.cBegin.end() - 1), rAt(T.rBegin.begin(), T.rBegin.end() - 1);
     forContributors([&](std::int64_t id, int r, std::int64_t w) {
         T.where[cAt[id]] = w;
         T.contributors[cAt[id]++] = r;
     });
-    forReaders([&](std::int64_t id, int r) { T.readers[rAt[id]++] = r; });
+    forReaders([&](std::int64_t id, int r, std::uint64_t nodes) {
+        T.readerNodes[rAt[id]] = nodes;
+        T.readers[rAt[id]++] = r;
+    });
     for (std::int64_t id = 0; id < nView; ++id) if (T.cBegin[id + 1] > T.cBegin[id]) T.byKey.push_back(id);
     std::sort(T.byKey.begin(), T.byKey.end(), [&](std::int64_t a, std::int64_t b) {
         return in.view.keyOf(a) < in.view.keyOf(b);
@@ -116,6 +122,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
         const std::int64_t self = std::find(C, C + m, in.me) - C;   // m: not a contributor
         const std::int64_t nChunks = std::min<std::int64_t>(m, npt), rot = std::int64_t(in.view.keyOf(id) % m);
         const auto summed = [&](int n) { return anyPositive(&in.invOmega[(id*npt + n)*per]); };
+        const auto readHere = [&](int n) { return (in.read[id] >> n & 1) != 0 && summed(n); };
         for (std::int64_t j = 0; j < nChunks; ++j)
         {
             const int n0 = int(j*npt/nChunks), nodes = int((j + 1)*npt/nChunks - j*npt/nChunks);
@@ -125,7 +132,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
                 if (self < m)
                     maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(in.me, W[self], n)); },
                                X.partialTo[owner]);
-                maskedRuns(id, n0, nodes, summed, X.fullFrom[owner]);
+                maskedRuns(id, n0, nodes, readHere, X.fullFrom[owner]);
                 continue;
             }
             X.owned.push_back(nodeRun{id, std::int32_t(n0), std::int32_t(nodes)});
@@ -148,7 +155,8 @@ chunkExchange planChunks(const chunkSources<D>& in)
             }
             X.termsBegin.push_back(std::int64_t(X.terms.size()));
             for (std::int64_t q = T.rBegin[id]; q < T.rBegin[id + 1]; ++q)
-                maskedRuns(id, n0, nodes, summed, X.fullTo[T.readers[q]]);
+                maskedRuns(id, n0, nodes, [&](int n) { return (T.readerNodes[q] >> n & 1) != 0 && summed(n); },
+                           X.fullTo[T.readers[q]]);
         }
     }
     X.partialCounts.assign(offset.begin(), offset.end());

@@ -37,10 +37,10 @@ struct chunkTerm
 /// contributor sends its partial sums on the chunks of its tiles that
 /// others own to their owners; each owner sums its chunks in rank order
 /// and divides them by omega. Round 2: each owner sends its chunks' phi to
-/// every other rank that reads the tile, which stores it: a rank clears and
-/// divides only what it owns. Only nodes with omega > 0 travel (a
-/// contributor's partial omega in round 1, the sum in round 2; both sides
-/// know them from the plan). Both sides list a message's runs in tile-key
+/// every other rank that reads the tile, at the nodes that rank reads, which
+/// it stores: a rank clears and divides only what it owns. Only nodes with
+/// omega > 0 travel (a contributor's partial omega in round 1, the sum in
+/// round 2; both sides know them from the plan). Both sides list a message's runs in tile-key
 /// order, chunks and nodes in order.
 struct chunkExchange
 {
@@ -67,6 +67,8 @@ struct chunkSources
     const std::vector<std::int64_t>& ownToView;              ///< own tile id -> view id
     const std::vector<std::vector<std::int64_t>>& tilesFrom; ///< per rank: the view tiles it contributes to
     const std::vector<std::vector<std::int64_t>>& tilesTo;   ///< per rank: the own tiles it reads
+    const std::vector<std::vector<std::uint64_t>>& readTo;   ///< per rank: the nodes it reads of each (bit n: node n)
+    const std::vector<std::uint64_t>& read;                  ///< per view tile: the nodes this rank reads
     const hugeVector<double>& ownOmega;                      ///< this rank's partial omega (own ids)
     const std::vector<std::vector<double>>& omegaFrom;       ///< per rank: its partial omega on tilesFrom's tiles
     const hugeVector<double>& invOmega;                      ///< 1/omega on the view (> 0 where omega is)

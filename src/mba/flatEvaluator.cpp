@@ -346,7 +346,7 @@ void flatEvaluator<D>::markReadEveryFit(std::deque<levelPlan<D>>& levels,
             continue;
         }
         for (int r = 0; r < nRanks && nRanks > 1; ++r)
-            if (L.ghostsTo[r].empty())
+            if (!L.byGhostsTo[r])
                 for (const std::int64_t id : L.tilesTo[r]) read[k][id] = 1;
         for (std::size_t q = 0; q < L.readEveryFit.size(); ++q)
         {

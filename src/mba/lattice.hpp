@@ -185,6 +185,12 @@ template <int D> struct stencil
     }
 };
 
+/// The nodes in a tile's node bits (stencil::nodesIn)
+inline int nodeCount(std::uint64_t nodes)
+{
+    return __builtin_popcountll(nodes);
+}
+
 /// Tile c of a stencil's tiles (box: stencil::tiles()): entry c of
 /// stencilTiles; may lie beyond the box (no such tile) along a direction
 /// where the stencil has one tile

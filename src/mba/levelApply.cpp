@@ -272,12 +272,13 @@ void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const std::vector<double>
         if (L.lone[q]) scatterSeparated<D>(L.phi.data(), nc, L.controlTiles[q], stencils_[q], &rr[q*nc], nullptr);
 }
 
-/// Exchange the partial delta of the requested tiles, or the residuals of
-/// the ghosts, and add the ranks' partial sums in rank order
+/// Exchange the partial delta at the requested tiles' nodes (nodesTo), or
+/// the residuals of the ghosts, and add the ranks' partial sums in rank order
 template <int D>
 void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals)
 {
-    const int P = comm_.size(), nc = ctrl_.nComponents, blk = levelPlan<D>::npt*nc;
+    constexpr int npt = levelPlan<D>::npt;
+    const int P = comm_.size(), nc = ctrl_.nComponents;
     send_.resize(P);
     recv_.resize(P);
     ghostSums_.resize(P);
@@ -285,20 +286,25 @@ void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<dou
     {
         send_[r].clear();
         recv_[r].resize(L.receiveCounts[r]);
-        if (!L.ghostsTo[r].empty())
+        if (L.byGhostsTo[r])
         {
             for (const std::uint32_t i : L.ghostsTo[r])
                 send_[r].insert(send_[r].end(), &residuals[i*nc], &residuals[i*nc] + nc);
             continue;
         }
-        for (auto id : L.tilesTo[r]) send_[r].insert(send_[r].end(), &L.phi[id*blk], &L.phi[(id + 1)*blk]);
+        for (std::size_t t = 0; t < L.tilesTo[r].size(); ++t)
+            for (std::uint64_t m = L.nodesTo[r][t]; m; m &= m - 1)
+            {
+                const double* p = &L.phi[(L.tilesTo[r][t]*npt + __builtin_ctzll(m))*nc];
+                send_[r].insert(send_[r].end(), p, p + nc);
+            }
     }
     comm_.exchange(send_, recv_);
     std::vector<const double*> got(P, nullptr);
     for (int r = 0; r < P; ++r)
     {
-        if (L.ghostTiles[r].empty()) got[r] = recv_[r].data();
-        else
+        if (!L.byGhostsFrom[r]) got[r] = recv_[r].data();
+        else if (!L.ghostTiles[r].empty())
         {
             ghostPartialSums(L, r, recv_[r], ghostSums_[r]);
             got[r] = ghostSums_[r].data();
@@ -350,11 +356,13 @@ void levelApplier<D>::ghostPartialSums(const levelPlan<D>& L, int r, const std::
 /// partial sums in the same order: bitwise the same delta). This rank's own
 /// sums are in place already; where a lower rank contributes too they are
 /// set aside and added at this rank's turn. got: per rank, its partial sums
-/// on the tiles received from it
+/// on the tiles received from it: at their nodesFrom (tiles), or at all
+/// their nodes (ghosts; none: null)
 template <int D>
 void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<const double*>& got)
 {
-    const int blk = levelPlan<D>::npt*ctrl_.nComponents;
+    constexpr int npt = levelPlan<D>::npt;
+    const int nc = ctrl_.nComponents, blk = npt*nc;
     std::vector<double>& own = setAside_;
     own.resize(L.sharedWithLower.size()*blk);
     for (std::size_t t = 0; t < L.sharedWithLower.size(); ++t)
@@ -371,8 +379,21 @@ void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<const do
     {
         if (r == comm_.rank())
             for (std::size_t t = 0; t < L.sharedWithLower.size(); ++t) add(L.sharedWithLower[t], &own[t*blk]);
+        else if (L.byGhostsFrom[r])
+        {
+            if (got[r])
+                for (std::size_t t = 0; t < L.tilesFrom[r].size(); ++t) add(L.tilesFrom[r][t], &got[r][t*blk]);
+        }
         else
-            for (std::size_t t = 0; t < L.tilesFrom[r].size(); ++t) add(L.tilesFrom[r][t], &got[r][t*blk]);
+        {
+            const double* dl = got[r];
+            for (std::size_t t = 0; t < L.tilesFrom[r].size(); ++t)
+                for (std::uint64_t m = L.nodesFrom[r][t]; m; m &= m - 1, dl += nc)
+                {
+                    double* ph = &L.phi[(L.tilesFrom[r][t]*npt + __builtin_ctzll(m))*nc];
+                    for (int c = 0; c < nc; ++c) ph[c] += dl[c];
+                }
+        }
     }
 }
 

@@ -66,8 +66,8 @@ levelPlan<D> levelPlanner<D>::run(int k)
     omegaFrom_.assign(nRanks_, {});
     if (nRanks_ > 1)
     {
-        answerRequests(comm_.exchange(tileRequests(bucketDirectory())));
-        chooseGhosts();
+        requests_ = tileRequests(bucketDirectory());
+        answerRequests(comm_.exchange(requests_));
     }
     assembleView();
     findControlTiles();
@@ -78,7 +78,11 @@ levelPlan<D> levelPlanner<D>::run(int k)
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
-        L_.receiveCounts[r] = L_.ghostTiles[r].empty() ? L_.tilesFrom[r].size()*npt*nc_ : L_.ghostTiles[r].size()*nc_;
+    {
+        std::size_t nodes = 0;
+        for (const std::uint64_t m : L_.nodesFrom[r]) nodes += std::size_t(nodeCount(m));
+        L_.receiveCounts[r] = (L_.byGhostsFrom[r] ? L_.ghostTiles[r].size() : nodes)*nc_;
+    }
     if (nRanks_ > 1) chooseExchange();
     if (!L_.separated && !L_.chunked && !L_.tree) findCoefficientRuns();
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
@@ -299,70 +303,102 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
 
 /// The own tiles other ranks asked for (wanted: per rank its keys, each
 /// followed by the nodes it reads there): their ids (tilesTo, own ids for
-/// now) and nodes (nodesTo_), and their keys and partial omega sent
+/// now), the nodes asked (asked_) and those whose partial sums tiles would
+/// carry (nodesTo); then how the sums go (chooseGhosts), and to each asking
+/// rank the answer: ghosts or tiles, the keys of the tiles this rank holds
+/// with their nodesTo, their partial omega, and the ghosts
 template <int D>
 void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted)
 {
-    std::vector<std::vector<std::uint64_t>> keys(nRanks_);
-    std::vector<std::vector<double>> om(nRanks_);
-    nodesTo_.assign(nRanks_, {});
+    asked_.assign(nRanks_, {});
+    L_.nodesTo.assign(nRanks_, {});
     const int blk = npt*omegaPerNode_;
     for (int r = 0; r < nRanks_; ++r)
     {
         for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
         {
-            const std::uint64_t key = wanted[r][j];
-            const std::int64_t id = L_.ownLayout.findKey(key);
+            const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
             if (id < 0) continue;
+            std::uint64_t own = 0;   // the nodes where this rank's omega is > 0
+            for (int n = 0; n < blk; ++n) if (ownOmega_[id*blk + n] > 0) own |= std::uint64_t(1) << (n/omegaPerNode_);
             L_.tilesTo[r].push_back(id);
-            nodesTo_[r].push_back(wanted[r][j + 1]);
-            keys[r].push_back(key);
+            asked_[r].push_back(wanted[r][j + 1]);
+            L_.nodesTo[r].push_back(wanted[r][j + 1] & own);
+        }
+    }
+    const std::vector<std::vector<double>> gx = chooseGhosts();
+    std::vector<std::vector<std::uint64_t>> answer(nRanks_);
+    std::vector<std::vector<double>> om(nRanks_);
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        if (L_.tilesTo[r].empty()) continue;
+        answer[r].push_back(L_.byGhostsTo[r]);
+        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
+        {
+            const std::int64_t id = L_.tilesTo[r][j];
+            answer[r].insert(answer[r].end(), {L_.ownLayout.keyOf(id), L_.nodesTo[r][j]});
             om[r].insert(om[r].end(), ownOmega_.begin() + id*blk, ownOmega_.begin() + (id + 1)*blk);
         }
     }
-    keysFrom_ = comm_.exchange(keys);
+    const std::vector<std::vector<std::uint64_t>> got = comm_.exchange(answer);
+    L_.byGhostsFrom.assign(nRanks_, 0);
+    L_.nodesFrom.assign(nRanks_, {});
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        if (got[r].empty()) continue;
+        L_.byGhostsFrom[r] = std::uint8_t(got[r][0]);
+        for (std::size_t j = 1; j + 1 < got[r].size(); j += 2)
+        {
+            keysFrom_[r].push_back(got[r][j]);
+            L_.nodesFrom[r].push_back(got[r][j + 1]);
+        }
+    }
     omegaFrom_ = comm_.exchange(om);
+    L_.ghostsFrom = comm_.exchange(gx);
 }
 
-/// Ghost mode towards r when this rank's points that touch the nodes r
-/// asked for cost less per apply (nc values each) than the tiles (npt*nc):
-/// their coordinates and mask flags are sent once. (r then forms this
-/// rank's partial sums at those nodes only; it reads no other of the tiles.)
+/// Ghost mode towards r when this rank's points that reach the nodes r
+/// asked for are fewer than the nodes whose partial sums the tiles would
+/// carry (nc values each per apply); their coordinates and mask flags are
+/// sent once (returned, per rank). r then forms this rank's partial sums at
+/// the nodes it reads; it reads no other of the tiles. Where no point
+/// reaches them, ghost mode sends nothing.
 template <int D>
-void levelPlanner<D>::chooseGhosts()
+std::vector<std::vector<double>> levelPlanner<D>::chooseGhosts()
 {
     L_.ghostsTo.assign(nRanks_, {});
+    L_.byGhostsTo.assign(nRanks_, 0);
     std::vector<std::vector<double>> gx(nRanks_);
     std::vector<std::uint64_t> asked(nOwn_);
     for (int r = 0; r < nRanks_; ++r)
     {
         if (L_.tilesTo[r].empty()) continue;
         std::fill(asked.begin(), asked.end(), 0);
-        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j) asked[L_.tilesTo[r][j]] = nodesTo_[r][j];
-        // (a point that touches an asked tile but none of its asked nodes
-        // adds nothing r reads: left out, but for one if no other is left,
-        // so that r receives residuals and not the tiles)
-        std::size_t first = ctrl_.order.size();
-        const auto touches = [&](std::size_t q) {
-            bool tile = false, node = false;
+        std::size_t tileValues = 0;   // nodes, as tiles would carry them
+        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
+        {
+            asked[L_.tilesTo[r][j]] = asked_[r][j];
+            tileValues += std::size_t(nodeCount(L_.nodesTo[r][j]));
+        }
+        const auto reaches = [&](std::size_t q) {
+            bool tile = false;
             for (const std::int32_t id : ownIds_[q]) tile = tile || (id >= 0 && asked[id]);
             if (!tile) return false;
-            first = std::min(first, q);
             const stencil<D> st = ctrl_.stencilAt(q, L_.scale);
             const indexBox<D> tb = st.tiles();
-            for (int c = 0; c < (1 << D) && !node; ++c)
+            for (int c = 0; c < (1 << D); ++c)
             {
                 const std::int32_t id = ownIds_[q][c];
-                if (id >= 0 && asked[id]) node = (asked[id] & st.nodesIn(stencilTile<D>(tb, c))) != 0;
+                if (id >= 0 && (asked[id] & st.nodesIn(stencilTile<D>(tb, c))) != 0) return true;
             }
-            return node;
+            return false;
         };
         std::vector<std::uint32_t> g;
         std::vector<std::size_t> at;   // each ghost's position in order
-        for (std::size_t q = 0; q < ctrl_.order.size(); ++q)
-            if (touches(q)) { g.push_back(ctrl_.order[q]); at.push_back(q); }
-        if (g.empty() && first < ctrl_.order.size()) { g.push_back(ctrl_.order[first]); at.push_back(first); }
-        if (g.size() >= std::size_t(npt)*L_.tilesTo[r].size()) continue;
+        for (std::size_t q = 0; q < ctrl_.order.size() && g.size() < tileValues; ++q)
+            if (reaches(q)) { g.push_back(ctrl_.order[q]); at.push_back(q); }
+        if (g.size() >= tileValues) continue;
+        L_.byGhostsTo[r] = 1;
         for (std::size_t k = 0; k < g.size(); ++k)
         {
             const std::uint32_t i = g[k];
@@ -376,7 +412,7 @@ void levelPlanner<D>::chooseGhosts()
         }
         L_.ghostsTo[r] = std::move(g);
     }
-    L_.ghostsFrom = comm_.exchange(gx);
+    return gx;
 }
 
 /// The view: own and received tiles, dense when that is not much larger;
@@ -592,12 +628,13 @@ void levelPlanner<D>::fillStats()
     {
         s.tilesSent += std::int64_t(L.tilesTo[r].size());
         s.tilesReceived += std::int64_t(L.tilesFrom[r].size());
-        s.messagesSent += !L.tilesTo[r].empty();
-        s.messagesReceived += !L.tilesFrom[r].empty();
         s.ghostsSent += std::int64_t(L.ghostsTo[r].size());
         s.ghostsReceived += std::int64_t(L.ghostTiles[r].size());
-        const std::int64_t vs = L.ghostsTo[r].empty() ? std::int64_t(L.tilesTo[r].size())*npt*nc_
-            : std::int64_t(L.ghostsTo[r].size())*nc_;
+        std::int64_t nodes = 0;
+        for (const std::uint64_t m : L.nodesTo[r]) nodes += nodeCount(m);
+        const std::int64_t vs = (L.byGhostsTo[r] ? std::int64_t(L.ghostsTo[r].size()) : nodes)*nc_;
+        s.messagesSent += vs > 0;
+        s.messagesReceived += L.receiveCounts[r] > 0;
         s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
         s.bytesReceivedPerApply += std::int64_t(L.receiveCounts[r]*sizeof(double));
         s.bytes += std::int64_t((L.ghostsFrom[r].capacity() + L.ghostScales[r].capacity())*sizeof(double)

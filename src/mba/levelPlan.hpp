@@ -6,17 +6,17 @@
 // Own tiles are clustered into buckets whose index boxes are all-gathered (a
 // small directory of who holds what); each rank asks the owners of the
 // buckets that meet its query points' stencils for exactly the tiles those
-// stencils touch and receives their partial sums in every apply. Where the
-// owner's control points that touch the asked tiles are fewer than the
-// tiles' nodes, it sends their coordinates once and their residuals per
+// stencils touch, saying which nodes of each they read, and receives in
+// every apply the owners' partial sums at those nodes (where the owner's
+// points have weight). Where the owner's control points that reach those
+// nodes are fewer, it sends their coordinates once and their residuals per
 // apply instead ("ghosts"), and the asking rank forms the owner's partial
-// sums itself. The asking rank also says which nodes of the tiles its
-// stencils read, and the ghosts are the points that reach those nodes: its
-// other nodes of the tiles then hold part of the sum, which no point reads.
-// (The flat lattice refines them too, but a refined node that a point's
-// stencil weighs by w > 0 takes only coarse nodes whose basis is positive
-// at the point, the subdivision's weights and the basis being non-negative:
-// nodes of the point's coarse stencil, which hold the whole sum.)
+// sums itself. The asking rank's other nodes of the tiles then hold part of
+// the sum, which no point reads. (The flat lattice refines them too, but a
+// refined node that a point's stencil weighs by w > 0 takes only coarse
+// nodes whose basis is positive at the point, the subdivision's weights and
+// the basis being non-negative: nodes of the point's coarse stencil, which
+// hold the whole sum.)
 // A level is "separated" when no two control points share a node: every
 // node's phi then comes from one point alone.
 #ifndef MBA_LEVELPLAN_HPP
@@ -94,6 +94,15 @@ struct levelPlan
     std::vector<std::int64_t> sharedWithLower;
     std::vector<stencilTiles<D>> controlTiles; ///< the view tiles of the own control points' stencils, in order
 
+    /// Per rank of the direct exchange: whether the partial sums towards
+    /// it (To) and from it (From) go as ghosts (the sender's residuals, see
+    /// ghostsTo) rather than as tiles. Ghosts may be none: the sender's
+    /// points reach no node the reader reads, and nothing travels
+    std::vector<std::uint8_t> byGhostsTo, byGhostsFrom;
+    /// Per rank, tiles: per tile of tilesTo (tilesFrom) the nodes whose
+    /// partial sums travel, bit n for node n: those the reader's stencils
+    /// read where the sender's omega is > 0 (elsewhere its sums are 0)
+    std::vector<std::vector<std::uint64_t>> nodesTo, nodesFrom;
     std::vector<std::vector<std::uint32_t>> ghostsTo; ///< per rank: own points whose residuals go there (ghost mode)
     /// per rank: its ghosts, D coordinates + nc mask flags + whether it
     /// continues the previous ghost's run of equal stencils (1) each

@@ -18,8 +18,17 @@ void levelPlanner<D>::chooseExchange()
     if (mode_ == params::exchangeMode::direct || L_.separated) return;
     if (mode_ != params::exchangeMode::tree)
     {
+        // the nodes this rank reads, per view tile (it asks every holder of a
+        // tile for the same nodes)
+        std::vector<std::uint64_t> read(L_.view.size(), 0);
+        for (const auto& q : requests_)
+            for (std::size_t j = 0; j + 1 < q.size(); j += 2)
+            {
+                const std::int64_t id = L_.view.findKey(q[j]);
+                if (id >= 0) read[id] |= q[j + 1];
+            }
         chunkExchange X = planChunks<D>(chunkSources<D>{nRanks_, me_, nc_, omegaPerNode_, L_.view, ownToView_,
-            L_.tilesFrom, L_.tilesTo, ownOmega_, omegaFrom_, L_.invOmega});
+            L_.tilesFrom, L_.tilesTo, asked_, read, ownOmega_, omegaFrom_, L_.invOmega});
         bool take = true;
         if (mode_ == params::exchangeMode::automatic)
         {
@@ -111,6 +120,10 @@ void levelPlanner<D>::considerTree()
 template <int D>
 void levelPlanner<D>::dropDirectExchange()
 {
+    L_.byGhostsTo.assign(nRanks_, 0);
+    L_.byGhostsFrom.assign(nRanks_, 0);
+    L_.nodesTo.assign(nRanks_, {});
+    L_.nodesFrom.assign(nRanks_, {});
     L_.ghostsTo.assign(nRanks_, {});
     L_.ghostsFrom.assign(nRanks_, {});
     L_.ghostTiles.assign(nRanks_, {});

@@ -35,15 +35,18 @@ class levelPlanner
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
     std::vector<std::int64_t> ownToView_;              ///< own tile id -> view id (parallel)
-    /// per rank: the nodes it reads of each tile in tilesTo (bit n: node n)
-    std::vector<std::vector<std::uint64_t>> nodesTo_;
+    /// per rank: the tiles this rank asked it for, each key followed by the
+    /// nodes this rank reads there (bit n: node n)
+    std::vector<std::vector<std::uint64_t>> requests_;
+    /// per rank: the nodes it reads of each tile in tilesTo
+    std::vector<std::vector<std::uint64_t>> asked_;
 
     void ownTilesAndOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
     std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
     void answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted);
-    void chooseGhosts();
+    std::vector<std::vector<double>> chooseGhosts();
     void assembleView();
     void sumOmega(const std::vector<std::int64_t>& ownToView);
     void findControlTiles();

@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <map>
 #include <set>
 
 
@@ -538,8 +539,9 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
 namespace {
 
 /// A surface (points on the cube's faces, the morphing case) and scattered
-/// evaluation points on P slabs along x, fitted with the direct exchange:
-/// which rank holds each point, and each rank's levels
+/// evaluation points on P slabs along x (the control points on the first
+/// controlRanks of them), fitted with the given exchange: which rank holds
+/// each point, and each rank's levels
 struct surfaceOnSlabs
 {
     const std::vector<point<3>> c = surfacePoints<3>(40), e = randomPoints<3>(8000, 111);
@@ -547,15 +549,15 @@ struct surfaceOnSlabs
     std::vector<std::vector<levelStats>> stats;
     domain<3> dom;
 
-    explicit surfaceOnSlabs(int P)
+    surfaceOnSlabs(int P, params::exchangeMode exchange, int controlRanks)
     :
-        rc(ranksOf<3>(c, P, partition::slabs, 1)), re(ranksOf<3>(e, P, partition::slabs, 2)), stats(P)
+        rc(ranksOf<3>(c, controlRanks, partition::slabs, 1)), re(ranksOf<3>(e, P, partition::slabs, 2)), stats(P)
     {
         const auto v = smoothValues<3>(c, 3);
         params p;
         p.tolerance = 1e-8;
         p.maxLevels = 9;
-        p.exchange = params::exchangeMode::direct;
+        p.exchange = exchange;
         runSimulated(P, [&](const communicator& comm) {
             std::vector<point<3>> cl, el;
             std::vector<double> vl;
@@ -568,99 +570,131 @@ struct surfaceOnSlabs
             if (comm.rank() == 0) dom = m.dom();
         });
     }
+
+    /// f(node key, tile key) for each node of x's stencil at level k
+    /// (positive: of positive weight; the cubic basis' last weight is 0 on
+    /// a knot)
+    template <class F>
+    void forStencil(int k, const point<3>& x, bool positive, F f) const
+    {
+        const auto key = [](std::int64_t i, std::int64_t j, std::int64_t l) { return (i*100003 + j)*100019 + l; };
+        const double s = std::ldexp(1.0, k);
+        const point<3> u = dom.local0(x.data());
+        std::int64_t b[3];
+        bool knot[3];
+        for (int d = 0; d < 3; ++d)
+        {
+            b[d] = std::int64_t(u[d]*s);
+            knot[d] = u[d]*s == double(b[d]);
+        }
+        for (int a0 = 0; a0 < 4; ++a0)
+            for (int a1 = 0; a1 < 4; ++a1)
+                for (int a2 = 0; a2 < 4; ++a2)
+                {
+                    if (positive && ((a0 == 3 && knot[0]) || (a1 == 3 && knot[1]) || (a2 == 3 && knot[2]))) continue;
+                    const std::int64_t i = b[0] + a0, j = b[1] + a1, l = b[2] + a2;
+                    f(key(i, j, l), key(i/tileEdge, j/tileEdge, l/tileEdge));
+                }
+    }
 };
 
 } // namespace
 
-TEST_CASE("a rank receives as ghosts only the points that reach nodes it reads", "[parallel]")
+TEST_CASE("a rank receives per level from each rank the fewer of its points and of its nodes that reach what it reads", "[parallel]")
 {
-    // A surface on 4 slabs (surfaceOnSlabs). On a level that only
-    // stencils read (finer than every rank's flat lattice), a rank receives
-    // the other ranks' points whose stencils reach a node that its own
-    // points' stencils (control and evaluation points) read, not every point
-    // that reaches a tile it reads; counted here node by node. Levels 5 and
-    // 6: a rank's 2000 evaluation points fold levels up to 4 into its flat
-    // lattice (at most 4096 nodes), and levels 5 and 6 have points that
-    // reach the tiles but not the nodes.
-    const int P = 4;
-    const surfaceOnSlabs run(P);
+    // A surface on 2, 4 and 8 slabs (surfaceOnSlabs: the direct exchange).
+    // On a level, rank r reads the nodes of its points' stencils (control
+    // and evaluation points). From each other rank s it receives per apply
+    // either the residuals of s's control points whose stencils reach one of
+    // those nodes (ghosts) or s's partial sums at those of the nodes where a
+    // point of s has weight (tiles), whichever are fewer (tiles on a tie), 3
+    // values each; counted here node by node, on every level.
+    const int P = GENERATE(2, 4, 8);
+    const surfaceOnSlabs run(P, params::exchangeMode::direct, P);
     const auto& c = run.c;
     const auto& e = run.e;
     const auto& rc = run.rc;
     const auto& re = run.re;
     const auto& st = run.stats;
-    const domain<3>& dom = run.dom;
-    auto key = [](std::int64_t i, std::int64_t j, std::int64_t l) { return (i*100003 + j)*100019 + l; };
-    for (const int k : {5, 6})
+    std::int64_t tileOnly = 0;   // points reaching a tile read, none of its nodes read
+    std::int64_t byGhosts = 0, byTiles = 0;   // pairs and levels where values travel each way
+    for (int k = 0; k < int(st[0].size()); ++k)
     {
-        REQUIRE(int(st[0].size()) > k);
-        const double s = std::ldexp(1.0, k);
-        auto base = [&](const point<3>& x) {
-            const point<3> u = dom.local0(x.data());
-            return std::array<std::int64_t, 3>{{std::int64_t(u[0]*s), std::int64_t(u[1]*s), std::int64_t(u[2]*s)}};
-        };
-        // f(node key, tile key) for each node of x's stencil
-        auto forStencil = [&](const point<3>& x, auto f) {
-            const auto b = base(x);
-            for (int a0 = 0; a0 < 4; ++a0)
-                for (int a1 = 0; a1 < 4; ++a1)
-                    for (int a2 = 0; a2 < 4; ++a2)
-                    {
-                        const std::int64_t i = b[0] + a0, j = b[1] + a1, l = b[2] + a2;
-                        f(key(i, j, l), key(i/tileEdge, j/tileEdge, l/tileEdge));
-                    }
-        };
-        std::int64_t tileOnly = 0;   // points reaching a tile read, none of its nodes read
+        const auto forStencil = [&](const point<3>& x, bool positive, auto f) { run.forStencil(k, x, positive, f); };
+        std::vector<std::set<std::int64_t>> reads(P), readTiles(P), weighs(P);
+        for (std::size_t i = 0; i < c.size(); ++i)
+        {
+            forStencil(c[i], false, [&](std::int64_t n, std::int64_t t) { reads[rc[i]].insert(n); readTiles[rc[i]].insert(t); });
+            forStencil(c[i], true, [&](std::int64_t n, std::int64_t) { weighs[rc[i]].insert(n); });
+        }
+        for (std::size_t i = 0; i < e.size(); ++i)
+            forStencil(e[i], false, [&](std::int64_t n, std::int64_t t) { reads[re[i]].insert(n); readTiles[re[i]].insert(t); });
         for (int r = 0; r < P; ++r)
         {
-            std::set<std::int64_t> nodes, tiles;
-            const auto add = [&](std::int64_t n, std::int64_t t) { nodes.insert(n); tiles.insert(t); };
-            for (std::size_t i = 0; i < c.size(); ++i) if (rc[i] == r) forStencil(c[i], add);
-            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == r) forStencil(e[i], add);
-            std::int64_t reaching = 0;
-            for (std::size_t i = 0; i < c.size(); ++i)
+            std::int64_t values = 0, ghosts = 0;
+            for (int from = 0; from < P; ++from)
             {
-                if (rc[i] == r) continue;
-                bool node = false, tile = false;
-                forStencil(c[i], [&](std::int64_t n, std::int64_t t) {
-                    node = node || nodes.count(n) > 0;
-                    tile = tile || tiles.count(t) > 0;
-                });
-                reaching += node;
-                tileOnly += tile && !node;
+                if (from == r) continue;
+                std::int64_t points = 0, nodes = 0;
+                for (std::size_t i = 0; i < c.size(); ++i)
+                {
+                    if (rc[i] != from) continue;
+                    bool node = false, tile = false;
+                    forStencil(c[i], false, [&](std::int64_t n, std::int64_t t) {
+                        node = node || reads[r].count(n) > 0;
+                        tile = tile || readTiles[r].count(t) > 0;
+                    });
+                    points += node;
+                    tileOnly += tile && !node;
+                }
+                for (const std::int64_t n : reads[r]) nodes += std::int64_t(weighs[from].count(n));
+                values += std::min(points, nodes);
+                if (points < nodes) ghosts += points;
+                byGhosts += points < nodes && points > 0;
+                byTiles += nodes <= points && nodes > 0;
             }
-            INFO("level " << k << ", rank " << r);
-            CHECK(st[r][k].ghostsReceived == reaching);
+            INFO(P << " ranks, level " << k << ", rank " << r);
+            CHECK(st[r][k].bytesReceivedPerApply == values*3*std::int64_t(sizeof(double)));
+            CHECK(st[r][k].ghostsReceived == ghosts);
         }
-        CHECK(tileOnly > 0);
     }
+    CHECK(tileOnly > 0);
+    CHECK(byGhosts > 0);
+    CHECK(byTiles > 0);
 }
 
-TEST_CASE("fine levels exchange ghost residuals, not tiles; coarse levels tiles", "[parallel]")
+TEST_CASE("chunked exchange: a rank receives the summed values of the nodes it reads", "[parallel][chunks]")
 {
-    // A surface on slabs (surfaceOnSlabs)
-    for (const int P : {2, 4, 8})
+    // A surface's control points on the first 3 of 4 slabs, evaluation
+    // points on all 4 (surfaceOnSlabs), chunked: the last rank contributes
+    // nothing, so it owns no chunk and receives only the summed chunks of the
+    // tiles it reads, at the nodes its stencils read where a control point
+    // has weight, 3 values each; counted here node by node, on every
+    // chunked level
+    const int P = 4;
+    const surfaceOnSlabs run(P, params::exchangeMode::chunked, P - 1);
+    const auto& st = run.stats;
+    int chunkedLevels = 0, partOfTiles = 0;   // (levels where it reads part of the tiles' weighed nodes)
+    for (int k = 0; k < int(st[P - 1].size()); ++k)
     {
-        const std::vector<std::vector<levelStats>> st = surfaceOnSlabs(P).stats;
-        int finestReceivers = 0;
-        for (int r = 0; r < P; ++r)
-        {
-            INFO(P << " ranks, rank " << r);
-            const levelStats& coarse = st[r][0];
-            const levelStats& finest = st[r].back();
-            // level 0: one tile from each other rank, cheaper than any ghost set
-            CHECK(coarse.ghostsReceived == 0);
-            CHECK(coarse.tilesReceived == P - 1);
-            CHECK(coarse.bytesReceivedPerApply == (P - 1)*tileLayout<3>::nodesPerTile*3*std::int64_t(sizeof(double)));
-            // finest level: ghosts, each costing 3 values instead of a tile's 64 x 3
-            if (finest.tilesReceived == 0) continue;
-            ++finestReceivers;
-            REQUIRE(finest.ghostsReceived > 0);
-            CHECK(finest.bytesReceivedPerApply == finest.ghostsReceived*3*std::int64_t(sizeof(double)));
-            CHECK(finest.bytesReceivedPerApply*8 < finest.tilesReceived*tileLayout<3>::nodesPerTile*3*std::int64_t(sizeof(double)));
-        }
-        CHECK(finestReceivers >= P - 1);
+        if (!st[P - 1][k].chunked) continue;
+        ++chunkedLevels;
+        std::set<std::int64_t> reads, readTiles;
+        std::map<std::int64_t, std::int64_t> weighed;   // node -> tile
+        for (std::size_t i = 0; i < run.e.size(); ++i)
+            if (run.re[i] == P - 1)
+                run.forStencil(k, run.e[i], false, [&](std::int64_t n, std::int64_t t) { reads.insert(n); readTiles.insert(t); });
+        for (const point<3>& x : run.c)
+            run.forStencil(k, x, true, [&](std::int64_t n, std::int64_t t) { weighed[n] = t; });
+        std::int64_t nodes = 0, tileNodes = 0;   // read and weighed; of the tiles read, weighed
+        for (const std::int64_t n : reads) nodes += std::int64_t(weighed.count(n));
+        for (const auto& w : weighed) tileNodes += std::int64_t(readTiles.count(w.second));
+        INFO("level " << k);
+        CHECK(st[P - 1][k].bytesReceivedPerApply == nodes*3*std::int64_t(sizeof(double)));
+        partOfTiles += nodes < tileNodes;
     }
+    CHECK(chunkedLevels >= 4);
+    CHECK(partOfTiles >= 2);
 }
 
 TEST_CASE("bad input on one rank fails every rank with the same message", "[parallel][errors]")
