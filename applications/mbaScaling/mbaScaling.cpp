@@ -33,8 +33,9 @@
 // rank count and one RESULT line each (key=value), which benchmarks/scaling
 // reads; --levels adds the per-level exchange of the rank that receives most;
 // --lower-bound the least any exchange of values per level could receive
-// (lowerBoundBytes), against the share; --exchange the levels' exchange
-// (params::exchange; default automatic, the motion solver's).
+// (lowerBoundBytes), against the share (with --levels, per level too);
+// --exchange the levels' exchange (params::exchange; default automatic, the
+// motion solver's).
 
 #include "multilevel.hpp"
 
@@ -47,6 +48,7 @@
 #include <cstdio>
 #include <iostream>
 #include <mutex>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <string>
@@ -240,10 +242,10 @@ point<3> displacement(const point<3>& x)
 /// planes z = 0 and z = 1; owner(i, j, k) is the rank holding grid point (i,
 /// j, k) that counts it.
 template <class Owner>
-double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vector<point<3>>& query, int me,
-                       Owner owner)
+std::vector<double> lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vector<point<3>>& query,
+                                    int me, Owner owner)
 {
-    double total = 0;
+    std::vector<double> total(levels, 0.0);
     for (int k = 0; k < levels; ++k)
     {
         const double s = std::ldexp(1.0, k);
@@ -315,7 +317,7 @@ double lowerBoundBytes(const domain<3>& dom, int levels, long n, const std::vect
                 }
         double points = 0;
         for (const std::uint8_t r : remotePoint) points += r;
-        total += 24*std::min(nodes, points);
+        total[k] = 24*std::min(nodes, points);
     }
     return total;
 }
@@ -326,7 +328,7 @@ struct rankFigures
     double control = 0, evaluation = 0, neighbours = 0;
     double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
-    double lowerBound = 0;   ///< lowerBoundBytes
+    std::vector<double> lowerBound;   ///< lowerBoundBytes, per level
 };
 
 /// First index of part p of n cells in m parts, and the point range of the part
@@ -336,6 +338,7 @@ struct rankResult
 {
     std::vector<rankFigures> ranks;
     std::vector<levelStats> busiestLevels;   ///< the levels of the rank that receives most
+    std::vector<double> busiestLeast;        ///< its lowerBoundBytes per level (--lower-bound)
     int levels = 0;
     double maxResidual = 0;
 };
@@ -454,7 +457,7 @@ rankResult runRanks(const options& o, int P)
         res.maxResidual = rep.maxResidual;
         const bool busiest = std::none_of(res.ranks.begin(), res.ranks.end(),
                                           [&](const rankFigures& g) { return g.bytes > f.bytes; });
-        if (busiest) res.busiestLevels = mba.stats();
+        if (busiest) { res.busiestLevels = mba.stats(); res.busiestLeast = f.lowerBound; }
     });
     return res;
 }
@@ -507,7 +510,9 @@ int main(int argc, char** argv)
             const summary ev = over(v, [](const rankFigures& f) { return f.evalCpu; });
             const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
             const summary plan = over(v, [](const rankFigures& f) { return f.planCpu; });
-            const summary bound = over(v, [](const rankFigures& f) { return f.lowerBound; });
+            const summary bound = over(v, [](const rankFigures& f) {
+                return std::accumulate(f.lowerBound.begin(), f.lowerBound.end(), 0.0);
+            });
             // messages per neighbour and level: the bound the exchange keeps
             const summary perNb = over(v, [&](const rankFigures& f) {
                 return f.neighbours > 0 ? f.messages/(f.neighbours*res.levels) : 0.0;
@@ -534,15 +539,18 @@ int main(int argc, char** argv)
             if (o.levels)
             {
                 std::printf("  levels of the rank receiving most: level, exchange, tiles received, ghosts received, "
-                            "messages, bytes received, own tiles, view tiles, apply s, lone points\n");
+                            "messages, bytes received, own tiles, view tiles, apply s, lone points%s\n",
+                            o.lowerBound ? ", least bytes possible" : "");
                 for (const levelStats& s : res.busiestLevels)
-                    std::printf("  %5d %8s %8lld %8lld %4lld %10lld %8lld %8lld %9.6f %8lld\n", s.level,
+                    std::printf("  %5d %8s %8lld %8lld %4lld %10lld %8lld %8lld %9.6f %8lld%s\n", s.level,
                                 s.separated ? "separate" : s.tree ? "tree" : s.chunked ? "chunked" : "direct",
                                 static_cast<long long>(s.tilesReceived),
                                 static_cast<long long>(s.ghostsReceived), static_cast<long long>(s.messagesReceived),
                                 static_cast<long long>(s.bytesReceivedPerApply), static_cast<long long>(s.ownTiles),
                                 static_cast<long long>(s.viewTiles), s.seconds,
-                                static_cast<long long>(s.lonePoints));
+                                static_cast<long long>(s.lonePoints),
+                                s.level < int(res.busiestLeast.size())
+                                    ? (" " + std::to_string(std::llround(res.busiestLeast[s.level]))).c_str() : "");
             }
             std::fflush(stdout);
         }
