@@ -319,11 +319,9 @@ void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t
         {
             const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
             if (id < 0) continue;
-            std::uint64_t own = 0;   // the nodes where this rank's omega is > 0
-            for (int n = 0; n < blk; ++n) if (ownOmega_[id*blk + n] > 0) own |= std::uint64_t(1) << (n/omegaPerNode_);
             L_.tilesTo[r].push_back(id);
             asked_[r].push_back(wanted[r][j + 1]);
-            L_.nodesTo[r].push_back(wanted[r][j + 1] & own);
+            L_.nodesTo[r].push_back(wanted[r][j + 1] & ownNodes(id));
         }
     }
     const std::vector<std::vector<double>> gx = chooseGhosts();

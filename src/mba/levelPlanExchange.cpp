@@ -65,14 +65,11 @@ void levelPlanner<D>::considerTree()
     std::int64_t ownValues = 0;
     for (std::int64_t o = 0; o < nOwn_; ++o)
     {
-        std::uint64_t nodes = 0;
-        for (int n = 0; n < npt; ++n)
-            for (int c = 0; c < omegaPerNode_; ++c)
-                if (ownOmega_[(o*npt + n)*omegaPerNode_ + c] > 0) nodes |= std::uint64_t(1) << n;
+        const std::uint64_t nodes = ownNodes(o);
         if (!nodes) continue;
         mine.push_back(L_.view.keyOf(ownToView_[o]));
         mine.push_back(nodes);
-        ownValues += nc_*std::int64_t(__builtin_popcountll(nodes));
+        ownValues += nc_*std::int64_t(nodeCount(nodes));
     }
     const bool automatic = mode_ == params::exchangeMode::automatic;
     const double current = automatic ? currentExchangeCost() : 0;
@@ -96,7 +93,7 @@ void levelPlanner<D>::considerTree()
     for (const std::uint64_t m : nodes)
     {
         start.push_back(values);
-        values += nc_*std::int64_t(__builtin_popcountll(m));
+        values += nc_*std::int64_t(nodeCount(m));
     }
     if (automatic && !(treeExchangeCost(values) < current)) return;
     L_.tree = true;

@@ -55,6 +55,16 @@ class levelPlanner
     void findLonePoints();
     void findGhostTiles();
     void chooseExchange();
+    /// The nodes of own tile o where this rank's partial omega is > 0 (bit
+    /// n: node n): where its partial sums can be other than 0
+    std::uint64_t ownNodes(std::int64_t o) const
+    {
+        std::uint64_t nodes = 0;
+        for (int n = 0; n < npt; ++n)
+            for (int c = 0; c < omegaPerNode_; ++c)
+                if (ownOmega_[(o*npt + n)*omegaPerNode_ + c] > 0) nodes |= std::uint64_t(1) << n;
+        return nodes;
+    }
     void findCoefficientNodes();
     void findCoefficientRuns();
     void considerTree();
