@@ -129,7 +129,8 @@ void levelPlanner<D>::keepOmega()
     hugeVector<double>().swap(L_.invOmega);
 }
 
-/// levelPlan::coefficientRuns from coefficientNodes
+/// levelPlan::coefficientRuns from coefficientNodes, less the lone points'
+/// nodes (loneNodes_)
 template <int D>
 void levelPlanner<D>::findCoefficientRuns()
 {
@@ -140,15 +141,10 @@ void levelPlanner<D>::findCoefficientRuns()
         for (int j = 0; j < per; ++j) any |= L_.coefficientNodes[(n/npt)*per + j];
         return (any >> (n % npt) & 1) != 0;
     };
-    std::vector<std::uint8_t> loneNode(L_.lone.empty() ? 0 : nNodes, 0);
-    for (std::size_t q = 0; q < L_.lone.size(); ++q)
-        if (L_.lone[q])
-            detail::visitStencil(L_.controlTiles[q], ctrl_.stencilAt(q, L_.scale),
-                                 [&](std::int64_t id, int n, double) { loneNode[id*npt + n] = 1; });
     auto& runs = L_.coefficientRuns;
     for (std::int64_t n = 0; n < nNodes; ++n)
     {
-        if ((!loneNode.empty() && loneNode[n]) || !coefficient(n)) continue;
+        if ((!loneNodes_.empty() && loneNodes_[n]) || !coefficient(n)) continue;
         if (!runs.empty() && runs.back().first + runs.back().second == n) ++runs.back().second;
         else runs.emplace_back(n, 1);
     }
@@ -156,7 +152,7 @@ void levelPlanner<D>::findCoefficientRuns()
     // than the runs; not over the lone points' nodes)
     std::int64_t inRuns = 0;
     for (const auto& r : runs) inRuns += r.second;
-    if (2*inRuns > nNodes && loneNode.empty()) runs.assign(1, {0, nNodes});
+    if (2*inRuns > nNodes && loneNodes_.empty()) runs.assign(1, {0, nNodes});
 }
 
 /// This rank's tiles, the tiles of each control point's stencil (found once:
@@ -529,7 +525,7 @@ void levelPlanner<D>::findLonePoints()
     std::vector<stencil<D>> st(nq);
     for (std::size_t q = 0; q < nq; ++q) st[q] = ctrl_.stencilAt(q, L_.scale);
     L_.lone.assign(nq, 0);
-    std::size_t nLone = 0;
+    loneNodes_.clear();
     for (std::size_t q = 0; q < nq; ++q)
     {
         if ((q > 0 && st[q - 1].base == st[q].base) || (q + 1 < nq && st[q + 1].base == st[q].base)) continue;
@@ -537,9 +533,11 @@ void levelPlanner<D>::findLonePoints()
         for (const std::int32_t id : L_.controlTiles[q]) alone = alone && !(id >= 0 && !read.empty() && read[id]);
         alone = alone && aloneAtNodes(q, st[q], true);
         L_.lone[q] = alone;
-        nLone += alone;
+        if (!alone) continue;
+        loneNodes_.resize(std::size_t(L_.view.size())*npt, 0);
+        detail::visitStencil(L_.controlTiles[q], st[q], [&](std::int64_t id, int n, double) { loneNodes_[id*npt + n] = 1; });
     }
-    if (nLone == 0) L_.lone.clear();
+    if (loneNodes_.empty()) L_.lone.clear();
 }
 
 /// The ghosts' stencil tiles, numbered as the tiles received from their rank

@@ -40,6 +40,8 @@ class levelPlanner
     std::vector<std::vector<std::uint64_t>> requests_;
     /// per rank: the nodes it reads of each tile in tilesTo
     std::vector<std::vector<std::uint64_t>> asked_;
+    /// per view node: 1 at the lone points' nodes (empty: no lone point)
+    std::vector<std::uint8_t> loneNodes_;
 
     void ownTilesAndOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
