@@ -191,6 +191,13 @@ inline int nodeCount(std::uint64_t nodes)
     return __builtin_popcountll(nodes);
 }
 
+/// f(n) for each node n in a tile's node bits, in ascending order
+template <class F>
+void forEachNode(std::uint64_t nodes, F f)
+{
+    for (; nodes; nodes &= nodes - 1) f(__builtin_ctzll(nodes));
+}
+
 /// Tile c of a stencil's tiles (box: stencil::tiles()): entry c of
 /// stencilTiles; may lie beyond the box (no such tile) along a direction
 /// where the stencil has one tile

@@ -293,11 +293,10 @@ void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<dou
             continue;
         }
         for (std::size_t t = 0; t < L.tilesTo[r].size(); ++t)
-            for (std::uint64_t m = L.nodesTo[r][t]; m; m &= m - 1)
-            {
-                const double* p = &L.phi[(L.tilesTo[r][t]*npt + __builtin_ctzll(m))*nc];
+            forEachNode(L.nodesTo[r][t], [&](int n) {
+                const double* p = &L.phi[(L.tilesTo[r][t]*npt + n)*nc];
                 send_[r].insert(send_[r].end(), p, p + nc);
-            }
+            });
     }
     comm_.exchange(send_, recv_);
     std::vector<const double*> got(P, nullptr);
@@ -388,11 +387,11 @@ void levelApplier<D>::addInRankOrder(levelPlan<D>& L, const std::vector<const do
         {
             const double* dl = got[r];
             for (std::size_t t = 0; t < L.tilesFrom[r].size(); ++t)
-                for (std::uint64_t m = L.nodesFrom[r][t]; m; m &= m - 1, dl += nc)
-                {
-                    double* ph = &L.phi[(L.tilesFrom[r][t]*npt + __builtin_ctzll(m))*nc];
+                forEachNode(L.nodesFrom[r][t], [&](int n) {
+                    double* ph = &L.phi[(L.tilesFrom[r][t]*npt + n)*nc];
                     for (int c = 0; c < nc; ++c) ph[c] += dl[c];
-                }
+                    dl += nc;
+                });
         }
     }
 }

@@ -633,6 +633,7 @@ void levelPlanner<D>::fillStats()
         s.messagesReceived += L.receiveCounts[r] > 0;
         s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
         s.bytesReceivedPerApply += std::int64_t(L.receiveCounts[r]*sizeof(double));
+        s.bytes += std::int64_t((L.nodesTo[r].capacity() + L.nodesFrom[r].capacity())*sizeof(std::uint64_t));
         s.bytes += std::int64_t((L.ghostsFrom[r].capacity() + L.ghostScales[r].capacity())*sizeof(double)
             + L.ghostTiles[r].capacity()*sizeof(stencilTiles<D>) + L.ghostStencils[r].capacity()*sizeof(stencil<D>));
     }
