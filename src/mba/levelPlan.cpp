@@ -263,9 +263,15 @@ levelPlanner<D>::tileRequests(const std::vector<std::vector<std::int64_t>>& dire
         hashMap seen;
         clusterTiles.clear();
         clusterNodes.clear();
+        index<D> last;   // the previous point's stencil base (a point with the same adds nothing)
+        last.fill(-1);
         for (const double* x : clusters_.points[g])
         {
             const point<D> u = scaled<D>(dom_.local0(x), L_.scale);
+            index<D> base;
+            for (int d = 0; d < D; ++d) base[d] = std::int64_t(u[d]);
+            if (base == last) continue;
+            last = base;
             const stencil<D> st(u.data());
             forEachIndex<D>(st.tiles(), [&](const index<D>& t) {
                 const std::uint64_t key = L_.ownLayout.key(t);
