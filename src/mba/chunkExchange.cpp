@@ -89,6 +89,42 @@ void maskedRuns(std::int64_t id, int n0, int nodes, const std::function<bool(int
     }
 }
 
+/// The contributor (an index into the tile's m) that sums each of a tile's
+/// npt nodes, into owner: one of those whose partial omega is positive
+/// there (per node, a set of m bits in `words` words of reach). The nodes
+/// that the same contributors reach are split among them in contiguous
+/// shares in node order, rotated by the tile's key; a node that none reaches
+/// goes with the node before it (or the first that one reaches). Every rank
+/// that holds the tile knows all contributors' partial omega on it, hence
+/// the same owners.
+void nodeOwners(std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
+                std::size_t words, std::vector<int>& owner)
+{
+    owner.assign(npt, -1);
+    auto set = [&](int n) { return reach.begin() + n*words; };
+    std::vector<int> order(npt), members;
+    for (int n = 0; n < npt; ++n) order[n] = n;
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+        return std::lexicographical_compare(set(a), set(a) + words, set(b), set(b) + words);
+    });
+    for (int g = 0; g < npt;)
+    {
+        int e = g + 1;
+        while (e < npt && std::equal(set(order[g]), set(order[g]) + words, set(order[e]))) ++e;
+        members.clear();
+        for (std::int64_t c = 0; c < m; ++c)
+            if (set(order[g])[c/64] >> (c % 64) & 1) members.push_back(int(c));
+        const std::int64_t s = std::int64_t(members.size()), size = e - g;
+        for (int i = g; s > 0 && i < e; ++i)
+            owner[order[i]] = members[std::size_t(((i - g)*s/size + std::int64_t(key % std::uint64_t(s))) % s)];
+        g = e;
+    }
+    int first = 0;
+    while (first < npt && owner[first] < 0) ++first;
+    for (int n = 0; n < npt; ++n)
+        if (owner[n] < 0) owner[n] = n < first ? (first < npt ? owner[first] : 0) : owner[n - 1];
+}
+
 } // namespace
 
 template <int D>
@@ -114,19 +150,30 @@ chunkExchange planChunks(const chunkSources<D>& in)
     X.termsBegin.push_back(0);
     std::vector<std::int64_t> offset(in.nRanks, 0);   // values from each rank in round 1 so far
     std::vector<nodeRun> runs;
+    std::vector<std::uint64_t> reach;
+    std::vector<int> by;   // per node of a tile: the contributor that sums it
     for (const std::int64_t id : T.byKey)
     {
         const int* C = &T.contributors[T.cBegin[id]];
         const std::int64_t* W = &T.where[T.cBegin[id]];
         const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
         const std::int64_t self = std::find(C, C + m, in.me) - C;   // m: not a contributor
-        const std::int64_t nChunks = std::min<std::int64_t>(m, npt), rot = std::int64_t(in.view.keyOf(id) % m);
         const auto summed = [&](int n) { return anyPositive(&in.invOmega[(id*npt + n)*per]); };
         const auto readHere = [&](int n) { return (in.read[id] >> n & 1) != 0 && summed(n); };
-        for (std::int64_t j = 0; j < nChunks; ++j)
+        if (m == 1) by.assign(npt, 0);
+        else
         {
-            const int n0 = int(j*npt/nChunks), nodes = int((j + 1)*npt/nChunks - j*npt/nChunks);
-            const int owner = C[(j + rot) % m];
+            const std::size_t words = std::size_t((m + 63)/64);
+            reach.assign(npt*words, 0);
+            for (std::int64_t c = 0; c < m; ++c)
+                for (int n = 0; n < npt; ++n)
+                    if (anyPositive(partialOmega(C[c], W[c], n))) reach[n*words + c/64] |= std::uint64_t(1) << (c % 64);
+            nodeOwners(m, npt, in.view.keyOf(id), reach, words, by);
+        }
+        for (int n0 = 0, e = 1; n0 < npt; n0 = e++)
+        {
+            while (e < npt && by[e] == by[n0]) ++e;
+            const int nodes = e - n0, owner = C[by[n0]];
             if (owner != in.me)
             {
                 if (self < m)

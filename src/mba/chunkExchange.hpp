@@ -31,17 +31,21 @@ struct chunkTerm
     std::int32_t runsBegin, runsEnd;
 };
 
-/// The chunked exchange of a level (params::exchange). Each tile with
-/// contributors C (sorted ranks) is split into min(|C|, npt) chunks of
-/// nodes; chunk j belongs to C[(j + key) mod |C|]. Round 1: every
-/// contributor sends its partial sums on the chunks of its tiles that
-/// others own to their owners; each owner sums its chunks in rank order
-/// and divides them by omega. Round 2: each owner sends its chunks' phi to
-/// every other rank that reads the tile, at the nodes that rank reads, which
-/// it stores: a rank clears and divides only what it owns. Only nodes with
-/// omega > 0 travel (a contributor's partial omega in round 1, the sum in
-/// round 2; both sides know them from the plan). Both sides list a message's runs in tile-key
-/// order, chunks and nodes in order.
+/// The chunked exchange of a level (params::exchange). Each node of a tile
+/// with contributors C (sorted ranks) belongs to one of the contributors
+/// whose partial omega is positive there; the nodes with the same such
+/// contributors are split among them in contiguous shares in node order,
+/// rotated by the tile's key. A chunk is a run of a tile's nodes with the
+/// same owner. Round 1: every contributor sends its partial sums on the
+/// chunks of its tiles that others own to their owners; each owner sums its
+/// chunks in rank order and divides them by omega. Round 2: each owner sends
+/// its chunks' phi to every other rank that reads the tile, at the nodes
+/// that rank reads, which it stores: a rank clears and divides only what it
+/// owns. Only nodes with omega > 0 travel (a contributor's partial omega in
+/// round 1, the sum in round 2; both sides know them from the plan). Both
+/// sides list a message's runs in tile-key order, chunks and nodes in order.
+/// A node costs the ranks together (|C_n| - 1) + (|R_n| - 1) values, C_n
+/// the ranks whose points weigh it and R_n those that read it.
 struct chunkExchange
 {
     std::vector<std::vector<nodeRun>> partialTo; ///< per rank: own partial sums it sums (round 1)

@@ -697,6 +697,41 @@ TEST_CASE("chunked exchange: a rank receives the summed values of the nodes it r
     CHECK(partOfTiles >= 2);
 }
 
+TEST_CASE("chunked exchange: each node is summed by a rank whose points weigh it", "[parallel][chunks]")
+{
+    // A surface on 2, 4 and 8 slabs (surfaceOnSlabs), chunked. A node that
+    // the points of the ranks C weigh and the stencils of the ranks R read
+    // (C within R: a rank reads its control points' stencils) is summed by
+    // one of C: it receives the partial sums of the |C| - 1 others, and each
+    // of the |R| - 1 other readers the sum, 3 values each. Whichever of C
+    // sums it, the ranks receive that together on a level; a node summed by
+    // a rank that does not weigh it costs one value more. Counted here node
+    // by node, on every chunked level.
+    const int P = GENERATE(2, 4, 8);
+    const surfaceOnSlabs run(P, params::exchangeMode::chunked, P);
+    const auto& st = run.stats;
+    int chunkedLevels = 0;
+    for (int k = 0; k < int(st[0].size()); ++k)
+    {
+        if (!st[0][k].chunked) continue;
+        ++chunkedLevels;
+        std::map<std::int64_t, std::set<int>> weighs, reads;   // node -> ranks
+        for (std::size_t i = 0; i < run.c.size(); ++i)
+        {
+            run.forStencil(k, run.c[i], true, [&](std::int64_t n, std::int64_t) { weighs[n].insert(run.rc[i]); });
+            run.forStencil(k, run.c[i], false, [&](std::int64_t n, std::int64_t) { reads[n].insert(run.rc[i]); });
+        }
+        for (std::size_t i = 0; i < run.e.size(); ++i)
+            run.forStencil(k, run.e[i], false, [&](std::int64_t n, std::int64_t) { reads[n].insert(run.re[i]); });
+        std::int64_t values = 0, received = 0;
+        for (const auto& w : weighs) values += 3*std::int64_t(w.second.size() - 1 + reads[w.first].size() - 1);
+        for (int r = 0; r < P; ++r) received += st[r][k].bytesReceivedPerApply;
+        INFO(P << " ranks, level " << k);
+        CHECK(received == values*std::int64_t(sizeof(double)));
+    }
+    CHECK(chunkedLevels >= 4);
+}
+
 TEST_CASE("bad input on one rank fails every rank with the same message", "[parallel][errors]")
 {
     const int P = 3;
