@@ -89,20 +89,16 @@ void maskedRuns(std::int64_t id, int n0, int nodes, const std::function<bool(int
     }
 }
 
-/// The contributor (an index into the tile's m) that sums each of a tile's
-/// npt nodes, into owner: one of those whose partial omega is positive
-/// there (per node, a set of m bits in `words` words of reach). The nodes
-/// that the same contributors reach are split among them in contiguous
-/// shares in node order, rotated by the tile's key; a node that none reaches
-/// goes with the node before it (or the first that one reaches). Every rank
-/// that holds the tile knows all contributors' partial omega on it, hence
-/// the same owners.
-void nodeOwners(std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
-                std::size_t words, std::vector<int>& owner)
+
+} // namespace
+
+void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
+                std::size_t words, const std::vector<std::int64_t>& loads, std::vector<int>& owner)
 {
     owner.assign(npt, -1);
     auto set = [&](int n) { return reach.begin() + n*words; };
     std::vector<int> order(npt), members;
+    std::vector<std::int64_t> upTo;   // per member in turn: the summed weights up to it
     for (int n = 0; n < npt; ++n) order[n] = n;
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
         return std::lexicographical_compare(set(a), set(a) + words, set(b), set(b) + words);
@@ -115,8 +111,19 @@ void nodeOwners(std::int64_t m, int npt, std::uint64_t key, const std::vector<st
         for (std::int64_t c = 0; c < m; ++c)
             if (set(order[g])[c/64] >> (c % 64) & 1) members.push_back(int(c));
         const std::int64_t s = std::int64_t(members.size()), size = e - g;
-        for (int i = g; s > 0 && i < e; ++i)
-            owner[order[i]] = members[std::size_t(((i - g)*s/size + std::int64_t(key % std::uint64_t(s))) % s)];
+        if (s == 0) { g = e; continue; }
+        std::rotate(members.begin(), members.begin() + std::ptrdiff_t(key % std::uint64_t(s)), members.end());
+        std::int64_t M = 0;
+        for (const int c : members) M = std::max(M, loads[std::size_t(C[c])]);
+        upTo.assign(1, 0);
+        for (const int c : members) upTo.push_back(upTo.back() + (s < 3 ? 1 : M + M/16 + 1 - loads[std::size_t(C[c])]));
+        // node i of the group to the member whose weights hold its middle
+        std::size_t j = 0;
+        for (int i = g; i < e; ++i)
+        {
+            while (j + 1 < members.size() && (2*(i - g) + 1)*upTo.back() >= 2*size*upTo[j + 1]) ++j;
+            owner[order[i]] = members[j];
+        }
         g = e;
     }
     int first = 0;
@@ -124,8 +131,6 @@ void nodeOwners(std::int64_t m, int npt, std::uint64_t key, const std::vector<st
     for (int n = 0; n < npt; ++n)
         if (owner[n] < 0) owner[n] = n < first ? (first < npt ? owner[first] : 0) : owner[n - 1];
 }
-
-} // namespace
 
 template <int D>
 chunkExchange planChunks(const chunkSources<D>& in)
@@ -152,6 +157,37 @@ chunkExchange planChunks(const chunkSources<D>& in)
     std::vector<nodeRun> runs;
     std::vector<std::uint64_t> reach;
     std::vector<int> by;   // per node of a tile: the contributor that sums it
+    // per node of tile id: the contributors whose partial omega is positive
+    const auto tileReach = [&](std::int64_t id) {
+        const int* C = &T.contributors[T.cBegin[id]];
+        const std::int64_t* W = &T.where[T.cBegin[id]];
+        const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
+        const std::size_t words = std::size_t((m + 63)/64);
+        reach.assign(npt*words, 0);
+        for (std::int64_t c = 0; c < m; ++c)
+            for (int n = 0; n < npt; ++n)
+                if (anyPositive(partialOmega(C[c], W[c], n))) reach[n*words + c/64] |= std::uint64_t(1) << (c % 64);
+        return words;
+    };
+    // this rank's load, which no owner changes: the nodes it reads that
+    // another rank's points weigh
+    std::int64_t load = 0;
+    for (const std::int64_t id : T.byKey)
+    {
+        if (!in.read[id]) continue;
+        const int* C = &T.contributors[T.cBegin[id]];
+        const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
+        const std::size_t words = tileReach(id);
+        for (int n = 0; n < npt; ++n)
+        {
+            if (!(in.read[id] >> n & 1)) continue;
+            bool other = false;
+            for (std::int64_t c = 0; c < m && !other; ++c)
+                other = C[c] != in.me && (reach[n*words + c/64] >> (c % 64) & 1);
+            load += other;
+        }
+    }
+    const std::vector<std::int64_t> loads = in.gatherLoads(load*in.nc);
     for (const std::int64_t id : T.byKey)
     {
         const int* C = &T.contributors[T.cBegin[id]];
@@ -163,12 +199,8 @@ chunkExchange planChunks(const chunkSources<D>& in)
         if (m == 1) by.assign(npt, 0);
         else
         {
-            const std::size_t words = std::size_t((m + 63)/64);
-            reach.assign(npt*words, 0);
-            for (std::int64_t c = 0; c < m; ++c)
-                for (int n = 0; n < npt; ++n)
-                    if (anyPositive(partialOmega(C[c], W[c], n))) reach[n*words + c/64] |= std::uint64_t(1) << (c % 64);
-            nodeOwners(m, npt, in.view.keyOf(id), reach, words, by);
+            const std::size_t words = tileReach(id);
+            nodeOwners(C, m, npt, in.view.keyOf(id), reach, words, loads, by);
         }
         for (int n0 = 0, e = 1; n0 < npt; n0 = e++)
         {

@@ -9,6 +9,7 @@
 #include "lattice.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace mba {
@@ -33,10 +34,8 @@ struct chunkTerm
 
 /// The chunked exchange of a level (params::exchange). Each node of a tile
 /// with contributors C (sorted ranks) belongs to one of the contributors
-/// whose partial omega is positive there; the nodes with the same such
-/// contributors are split among them in contiguous shares in node order,
-/// rotated by the tile's key. A chunk is a run of a tile's nodes with the
-/// same owner. Round 1: every contributor sends its partial sums on the
+/// whose partial omega is positive there (nodeOwners). A chunk is a run of
+/// a tile's nodes with the same owner. Round 1: every contributor sends its partial sums on the
 /// chunks of its tiles that others own to their owners; each owner sums its
 /// chunks in rank order and divides them by omega. Round 2: each owner sends
 /// its chunks' phi to every other rank that reads the tile, at the nodes
@@ -62,6 +61,21 @@ struct chunkExchange
 /// Values (nc a node) of runs
 std::int64_t runValues(const std::vector<nodeRun>& runs, int nc);
 
+/// The contributor (an index into the tile's m, ranks C) that sums each of
+/// a tile's npt nodes (planChunks), into owner: one of those whose partial omega is
+/// positive there (per node, a set of m bits in `words` words of reach).
+/// The nodes that the same contributors reach are split among them in
+/// contiguous shares in node order, rotated by the tile's key. Summing a
+/// node that s contributors reach costs its owner s - 2 values more than
+/// the others (s - 1 partial sums in, the sum not received): from s = 3 the
+/// shares shrink with the rank's load (loads, per rank), by weight
+/// (1 + 1/16) M - load, M the largest load among the s. A node that none
+/// reaches goes with the node before it (or the first that one reaches).
+/// Every rank that holds the tile knows all contributors' partial omega on
+/// it, hence the same owners.
+void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
+                std::size_t words, const std::vector<std::int64_t>& loads, std::vector<int>& owner);
+
 /// What a level's plan knows that its chunks are made from (tiles as view ids)
 template <int D>
 struct chunkSources
@@ -76,6 +90,9 @@ struct chunkSources
     const hugeVector<double>& ownOmega;                      ///< this rank's partial omega (own ids)
     const std::vector<std::vector<double>>& omegaFrom;       ///< per rank: its partial omega on tilesFrom's tiles
     const hugeVector<double>& invOmega;                      ///< 1/omega on the view (> 0 where omega is)
+    /// every rank's load from this rank's (collective): the values a rank
+    /// receives on the level whoever sums the nodes
+    const std::function<std::vector<std::int64_t>(std::int64_t)>& gatherLoads;
 };
 
 /// The chunked exchange. Every rank that holds a tile in its view reads it

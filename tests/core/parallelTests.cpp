@@ -1,6 +1,7 @@
 // The distributed algorithm on simulated ranks: equal to serial, bitwise
 // consistent, communication bounded, failures collective; and the
 // communicator conformance suite for the serial and simulated implementations.
+#include "chunkExchange.hpp"
 #include "communicatorConformance.hpp"
 #include "testData.hpp"
 #include "treeSum.hpp"
@@ -730,6 +731,44 @@ TEST_CASE("chunked exchange: each node is summed by a rank whose points weigh it
         CHECK(received == values*std::int64_t(sizeof(double)));
     }
     CHECK(chunkedLevels >= 4);
+}
+
+TEST_CASE("chunk owners: a contributor that reaches the node, shares by load from three contributors on", "[chunks]")
+{
+    // A tile of 64 nodes and four contributors (ranks 2, 5, 7, 9): nodes
+    // 0-15 reached by the first alone, 16-31 by the first two, 32-62 by the
+    // last three, node 63 by none
+    const int C[4] = {2, 5, 7, 9};
+    std::vector<std::uint64_t> reach(64, 0);
+    for (int n = 0; n < 16; ++n) reach[n] = 0b0001;
+    for (int n = 16; n < 32; ++n) reach[n] = 0b0011;
+    for (int n = 32; n < 63; ++n) reach[n] = 0b1110;
+    std::vector<std::int64_t> loads(10, 0);
+    std::vector<int> owner;
+    const auto count = [&](int n0, int n1, int c) { return std::count(owner.begin() + n0, owner.begin() + n1, c); };
+    for (const std::uint64_t key : {0, 1, 2, 7})
+    {
+        INFO("key " << key);
+        // even loads: even shares
+        loads[5] = loads[7] = loads[9] = 1000;
+        nodeOwners(C, 4, 64, key, reach, 1, loads, owner);
+        for (int n = 0; n < 63; ++n) CHECK((reach[n] >> owner[n] & 1) == 1);
+        CHECK(owner[63] == owner[62]);
+        CHECK(count(0, 16, 0) == 16);
+        CHECK(count(16, 32, 0) == 8);
+        CHECK(count(16, 32, 1) == 8);
+        for (int c = 1; c < 4; ++c) CHECK((count(32, 63, c) == 10 || count(32, 63, c) == 11));
+        // rank 9 with half the others' load sums most of the nodes that
+        // three reach (its weight 563 against 63 each), the others a few
+        loads[9] = 500;
+        nodeOwners(C, 4, 64, key, reach, 1, loads, owner);
+        for (int n = 0; n < 63; ++n) CHECK((reach[n] >> owner[n] & 1) == 1);
+        CHECK(count(16, 32, 0) == 8);
+        CHECK(count(32, 63, 3) >= 25);
+        CHECK(count(32, 63, 3) <= 26);
+        CHECK(count(32, 63, 1) >= 2);
+        CHECK(count(32, 63, 2) >= 2);
+    }
 }
 
 TEST_CASE("bad input on one rank fails every rank with the same message", "[parallel][errors]")
