@@ -89,7 +89,6 @@ void maskedRuns(std::int64_t id, int n0, int nodes, const std::function<bool(int
     }
 }
 
-
 } // namespace
 
 void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
