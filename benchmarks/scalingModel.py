@@ -282,7 +282,8 @@ def main(argv):
             a2.set_title("%.3gM cells: modelled efficiency" % (n**3/1e6))
             a1.set_ylabel("speed-up")
             a2.set_ylabel("efficiency %")
-            a2.set_ylim(0, 115)
+            top = max([100*r[3] for m, d, nm, rows in cases if m == n for r in rows] + [100])
+            a2.set_ylim(0, 10*math.ceil(top/10 + 0.5))
             a2.axhline(80, color="k", lw=0.6, ls=":")
             for a in (a1, a2):
                 a.set_xlabel("ranks")
