@@ -32,19 +32,19 @@ struct chunkTerm
     std::int32_t runsBegin, runsEnd;
 };
 
-/// The chunked exchange of a level (params::exchange). Each node of a tile
-/// with contributors C (sorted ranks) belongs to one of the contributors
-/// whose partial omega is positive there (nodeOwners). A chunk is a run of
-/// a tile's nodes with the same owner. Round 1: every contributor sends its partial sums on the
-/// chunks of its tiles that others own to their owners; each owner sums its
-/// chunks in rank order and divides them by omega. Round 2: each owner sends
-/// its chunks' phi to every other rank that reads the tile, at the nodes
+/// The chunked exchange of a level (params::exchange). Each node of a tile with
+/// contributors C (sorted ranks) belongs to one of the contributors whose
+/// partial omega is positive there (nodeOwners). A chunk is a run of a tile's
+/// nodes with the same owner. Round 1: every contributor sends its partial sums
+/// on the chunks of its tiles that others own to their owners; each owner sums
+/// its chunks in rank order and divides them by omega. Round 2: each owner
+/// sends its chunks' phi to every other rank that reads the tile, at the nodes
 /// that rank reads, which it stores: a rank clears and divides only what it
 /// owns. Only nodes with omega > 0 travel (a contributor's partial omega in
-/// round 1, the sum in round 2; both sides know them from the plan). Both
-/// sides list a message's runs in tile-key order, chunks and nodes in order.
-/// A node costs the ranks together (|C_n| - 1) + (|R_n| - 1) values, C_n
-/// the ranks whose points weigh it and R_n those that read it.
+/// round 1, the sum in round 2; both sides know them from the plan). Both sides
+/// list a message's runs in tile-key order, chunks and nodes in order. A node
+/// costs the ranks together (|C_n| - 1) + (|R_n| - 1) values, C_n the ranks
+/// whose points weigh it and R_n those that read it.
 struct chunkExchange
 {
     std::vector<std::vector<nodeRun>> partialTo; ///< per rank: own partial sums it sums (round 1)
@@ -61,18 +61,17 @@ struct chunkExchange
 /// Values (nc a node) of runs
 std::int64_t runValues(const std::vector<nodeRun>& runs, int nc);
 
-/// The contributor (an index into the tile's m, ranks C) that sums each of
-/// a tile's npt nodes (planChunks), into owner: one of those whose partial omega is
-/// positive there (per node, a set of m bits in `words` words of reach).
-/// The nodes that the same contributors reach are split among them in
-/// contiguous shares in node order, rotated by the tile's key. Summing a
-/// node that s contributors reach costs its owner s - 2 values more than
-/// the others (s - 1 partial sums in, the sum not received): from s = 3 the
-/// shares shrink with the rank's load (loads, per rank), by weight
-/// (1 + 1/16) M - load, M the largest load among the s. A node that none
-/// reaches goes with the node before it (or the first that one reaches).
-/// Every rank that holds the tile knows all contributors' partial omega on
-/// it, hence the same owners.
+/// The contributor (an index into the tile's m, ranks C) that sums each of a
+/// tile's npt nodes (planChunks), into owner: one of those whose partial omega
+/// is positive there (per node, a set of m bits in `words` words of reach). The
+/// nodes that the same contributors reach are split among them in contiguous
+/// shares in node order, rotated by the tile's key. Summing a node that s
+/// contributors reach costs its owner s - 2 values more than the others (s - 1
+/// partial sums in, the sum not received): from s = 3 the shares shrink with
+/// the rank's load (loads, per rank), by weight M + M/16 + 1 - load, M the
+/// largest load among the s. A node that none reaches goes with the node before
+/// it (or the first that one reaches). Every rank that holds the tile knows all
+/// contributors' partial omega on it, hence the same owners.
 void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
                 std::size_t words, const std::vector<std::int64_t>& loads, std::vector<int>& owner);
 
