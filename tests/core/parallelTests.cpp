@@ -231,8 +231,8 @@ TEST_CASE("chunked exchange: the direct exchange's values, bit for bit, and seri
 TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many ranks share it", "[parallel][chunks]")
 {
     // level 0 is one tile that every rank contributes to and reads: directly
-    // each rank receives P - 1 tiles; in chunks its partial sums of one chunk
-    // from each other rank, then the other chunks summed (two tiles at most)
+    // each rank receives P - 1 tiles; in chunks the other ranks' partial sums
+    // of the nodes it sums, then the other nodes summed (two tiles at most)
     const auto c = surfacePoints<3>(20);
     const auto e = randomPoints<3>(3000, 74);
     const auto v = smoothValues<3>(c, 3);
