@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace mba {
 
@@ -189,6 +190,14 @@ template <int D> struct stencil
 inline int nodeCount(std::uint64_t nodes)
 {
     return __builtin_popcountll(nodes);
+}
+
+/// The nodes in a list of tiles' node bits
+inline std::int64_t nodeCount(const std::vector<std::uint64_t>& tiles)
+{
+    std::int64_t n = 0;
+    for (const std::uint64_t nodes : tiles) n += nodeCount(nodes);
+    return n;
 }
 
 /// f(n) for each node n in a tile's node bits, in ascending order

@@ -78,11 +78,8 @@ levelPlan<D> levelPlanner<D>::run(int k)
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
-    {
-        std::size_t nodes = 0;
-        for (const std::uint64_t m : L_.nodesFrom[r]) nodes += std::size_t(nodeCount(m));
-        L_.receiveCounts[r] = (L_.byGhostsFrom[r] ? L_.ghostTiles[r].size() : nodes)*nc_;
-    }
+        L_.receiveCounts[r] = nc_*(L_.byGhostsFrom[r] ? L_.ghostTiles[r].size()
+                                                      : std::size_t(nodeCount(L_.nodesFrom[r])));
     if (nRanks_ > 1) chooseExchange();
     if (!L_.separated && !L_.chunked && !L_.tree) findCoefficientRuns();
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
@@ -374,12 +371,8 @@ std::vector<std::vector<double>> levelPlanner<D>::chooseGhosts()
     {
         if (L_.tilesTo[r].empty()) continue;
         std::fill(asked.begin(), asked.end(), 0);
-        std::size_t tileValues = 0;   // nodes, as tiles would carry them
-        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
-        {
-            asked[L_.tilesTo[r][j]] = asked_[r][j];
-            tileValues += std::size_t(nodeCount(L_.nodesTo[r][j]));
-        }
+        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j) asked[L_.tilesTo[r][j]] = asked_[r][j];
+        const std::size_t tileValues = std::size_t(nodeCount(L_.nodesTo[r]));   // nodes, as tiles would carry them
         const auto reaches = [&](std::size_t q) {
             bool tile = false;
             for (const std::int32_t id : ownIds_[q]) tile = tile || (id >= 0 && asked[id]);
@@ -632,9 +625,7 @@ void levelPlanner<D>::fillStats()
         s.tilesReceived += std::int64_t(L.tilesFrom[r].size());
         s.ghostsSent += std::int64_t(L.ghostsTo[r].size());
         s.ghostsReceived += std::int64_t(L.ghostTiles[r].size());
-        std::int64_t nodes = 0;
-        for (const std::uint64_t m : L.nodesTo[r]) nodes += nodeCount(m);
-        const std::int64_t vs = (L.byGhostsTo[r] ? std::int64_t(L.ghostsTo[r].size()) : nodes)*nc_;
+        const std::int64_t vs = (L.byGhostsTo[r] ? std::int64_t(L.ghostsTo[r].size()) : nodeCount(L.nodesTo[r]))*nc_;
         s.messagesSent += vs > 0;
         s.messagesReceived += L.receiveCounts[r] > 0;
         s.bytesSentPerApply += vs*std::int64_t(sizeof(double));
