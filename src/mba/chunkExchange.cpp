@@ -190,17 +190,21 @@ chunkExchange planChunks(const chunkSources<D>& in)
     for (const std::int64_t id : T.byKey)
     {
         const int* C = &T.contributors[T.cBegin[id]];
-        const std::int64_t* W = &T.where[T.cBegin[id]];
         const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
         const std::int64_t self = std::find(C, C + m, in.me) - C;   // m: not a contributor
         const auto summed = [&](int n) { return anyPositive(&in.invOmega[(id*npt + n)*per]); };
         const auto readHere = [&](int n) { return (in.read[id] >> n & 1) != 0 && summed(n); };
+        std::size_t words = 0;
         if (m == 1) by.assign(npt, 0);
         else
         {
-            const std::size_t words = tileReach(id);
+            words = tileReach(id);
             nodeOwners(C, m, npt, in.view.keyOf(id), reach, words, loads, by);
         }
+        // whether contributor c's partial omega is positive at node n (asked
+        // only where m > 1: a tile's sole contributor sums it all and sends
+        // no partial sum)
+        const auto weighs = [&](std::int64_t c, int n) { return (reach[n*words + c/64] >> (c % 64) & 1) != 0; };
         for (int n0 = 0, e = 1; n0 < npt; n0 = e++)
         {
             while (e < npt && by[e] == by[n0]) ++e;
@@ -208,8 +212,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
             if (owner != in.me)
             {
                 if (self < m)
-                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(in.me, W[self], n)); },
-                               X.partialTo[owner]);
+                    maskedRuns(id, n0, nodes, [&](int n) { return weighs(self, n); }, X.partialTo[owner]);
                 maskedRuns(id, n0, nodes, readHere, X.fullFrom[owner]);
                 continue;
             }
@@ -220,7 +223,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
                 if (C[c] != in.me)
                 {
                     runs.clear();
-                    maskedRuns(id, n0, nodes, [&](int n) { return anyPositive(partialOmega(C[c], W[c], n)); }, runs);
+                    maskedRuns(id, n0, nodes, [&](int n) { return weighs(c, n); }, runs);
                     term.offset = offset[C[c]];
                     for (const nodeRun& r : runs)
                     {
