@@ -465,6 +465,11 @@ TEST_CASE("rigidLayers: bad input names the entry and the valid choices", "[foam
     const std::string unknown =
         errorOf("rigidLayers { patches (walls sphere); innerDistance 0.1; outerDistance 0.2; }");
     CHECK_THAT(unknown, Contains("patches") && Contains("sphere") && Contains("(walls)"));
+    CHECK_THAT
+    (
+        errorOf("rigidLayers { patches (); innerDistance 0.1; outerDistance 0.2; }"),
+        Contains("patches: the list is empty") && Contains("(walls)")
+    );
     // A group names its patches (wall patches are in the group 'wall')
     CHECK(errorOf("rigidLayers { patches (wall); innerDistance 0.1; outerDistance 0.2; }") == "no error");
     CHECK(errorOf("rigidLayers { patches (walls); innerDistance 0.1; outerDistance 0.2; }", "RBF") == "no error");

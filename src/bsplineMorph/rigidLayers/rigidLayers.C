@@ -90,6 +90,14 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
             valid.append(pbm[patchi].name());
         }
     }
+    if (patterns.empty())
+    {
+        FatalIOErrorInFunction(dict)
+            << "patches: the list is empty; name the walls whose layers move"
+            << " with them (valid patches: " << flatOutput(valid)
+            << ", and groups of them), or remove rigidLayers"
+            << exit(FatalIOError);
+    }
     const HashTable<labelList>& groups = pbm.groupPatchIDs();
     labelHashSet ids;
     for (const wordRe& pattern : patterns)
