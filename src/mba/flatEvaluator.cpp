@@ -9,6 +9,12 @@
 
 namespace mba {
 
+double flatNodeBudget(std::size_t nEval)
+{
+    const double n = double(nEval);
+    return std::max({4096.0, std::min(n, 65536.0), n/8});
+}
+
 namespace {
 
 /// Asks the cache for the rows of the flat lattice's stencil at u (level-local
@@ -176,22 +182,15 @@ void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, con
     markReadEveryFit(levels, read, nRanks);
 }
 
-/// The finest of the first nLevels levels whose node box has at most as
-/// many nodes as there are evaluation points (at least 4096); -1: none
+/// The finest of the first nLevels levels whose node box has at most
+/// flatNodeBudget() nodes; -1: none
 template <int D>
 int flatEvaluator<D>::chooseFlatLevel(int nLevels) const
 {
+    const double budget = flatNodeBudget(eval_.size());
     int m = -1;
-    while (m + 1 < nLevels && boxNodes<D>(evalNodeBox(m + 1)) <= flatBudget()) ++m;
+    while (m + 1 < nLevels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
     return m;
-}
-
-/// The most nodes a flat lattice has: as many as there are evaluation
-/// points, at least 4096
-template <int D>
-double flatEvaluator<D>::flatBudget() const
-{
-    return double(std::max<std::size_t>(eval_.size(), 4096));
 }
 
 /// flatPhi_: the affine approximation and levels 0..m, refined to level m

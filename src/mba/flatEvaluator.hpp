@@ -17,6 +17,15 @@
 
 namespace mba {
 
+/// The most nodes a flat lattice of a rank with nEval evaluation points
+/// has: one a point up to 65536 (1.5 MB at three values a node, about what
+/// one core's caches hold), one per 8 points where that is more, and at
+/// least 4096. A larger lattice, read from main memory and refined there in
+/// every fit, costs more than the finer levels that the points near the
+/// control points then add one by one (BENCHMARKS.md, "The flat lattice's
+/// size")
+double flatNodeBudget(std::size_t nEval);
+
 template <int D>
 class flatEvaluator
 {
@@ -26,8 +35,8 @@ class flatEvaluator
     const int nc_;                      ///< values a point
 
     /// The finest level folded into the flat lattice: the finest whose box
-    /// has at most as many nodes as there are evaluation points (at least
-    /// 4096); -1: none (evaluation then sums the levels' tiles point by point)
+    /// has at most flatNodeBudget(evaluation points) nodes; -1: none
+    /// (evaluation then sums the levels' tiles point by point)
     int flatLevel_ = -1;
     indexBox<D> flatBox_;               ///< the flat lattice's nodes (at level flatLevel_)
     hugeVector<double> flatPhi_;        ///< its coefficients, nc a node (kept: no new pages per fit)
@@ -45,7 +54,6 @@ class flatEvaluator
     mutable hugeVector<double> sweptValues_;
 
     indexBox<D> evalNodeBox(int k) const;
-    double flatBudget() const;
     int chooseFlatLevel(int nLevels) const;
     void foldLevels(const std::deque<levelPlan<D>>& levels, int m, const affineFit<D>& affine);
     void addAffine(const indexBox<D>& b, const affineFit<D>& affine);

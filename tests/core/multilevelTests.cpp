@@ -1,4 +1,5 @@
 // Serial multilevel B-spline approximation: invariants, sparsity, plan/apply, bad input
+#include "flatEvaluator.hpp"
 #include "testData.hpp"
 
 #include <catch2/catch.hpp>
@@ -289,6 +290,19 @@ void separatedLevels(bool masked)
 }
 
 } // namespace
+
+TEST_CASE("the flat lattice holds a node a point up to 65536 nodes and one per 8 points beyond", "[core]")
+{
+    CHECK(flatNodeBudget(0) == 4096);
+    CHECK(flatNodeBudget(1000) == 4096);
+    CHECK(flatNodeBudget(20000) == 20000);
+    CHECK(flatNodeBudget(65536) == 65536);
+    // 97k points (the twisted cube at 46^3 cells) keep the 43k nodes of level 5
+    CHECK(flatNodeBudget(100000) == 65536);
+    CHECK(flatNodeBudget(524288) == 65536);
+    // 8M points: one node per 8 (level 6 of the cube, 300k nodes, not level 7's 2.25M)
+    CHECK(flatNodeBudget(8000000) == 1000000);
+}
 
 TEST_CASE("levels that separate the control points equal the plain method", "[core]")
 {
