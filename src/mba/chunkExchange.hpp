@@ -6,10 +6,10 @@
 #define MBA_CHUNKEXCHANGE_HPP
 
 #include "hugePages.hpp"
+#include "communicator.hpp"
 #include "lattice.hpp"
 
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 namespace mba {
@@ -89,9 +89,8 @@ struct chunkSources
     const hugeVector<double>& ownOmega;                      ///< this rank's partial omega (own ids)
     const std::vector<std::vector<double>>& omegaFrom;       ///< per rank: its partial omega on tilesFrom's tiles
     const hugeVector<double>& invOmega;                      ///< 1/omega on the view (> 0 where omega is)
-    /// every rank's load from this rank's (collective): the values a rank
-    /// receives on the level whoever sums the nodes
-    const std::function<std::vector<std::int64_t>(std::int64_t)>& gatherLoads;
+    /// the ranks (planChunks gathers each rank's load on the level through it)
+    const communicator& comm;
 };
 
 /// The chunked exchange. Every rank that holds a tile in its view reads it

@@ -27,13 +27,8 @@ void levelPlanner<D>::chooseExchange()
                 const std::int64_t id = L_.view.findKey(q[j]);
                 if (id >= 0) read[id] |= q[j + 1];
             }
-        const std::function<std::vector<std::int64_t>(std::int64_t)> gatherLoads = [this](std::int64_t mine) {
-            std::vector<std::int64_t> all;
-            for (const auto& r : comm_.allGather(std::vector<std::int64_t>{mine})) all.push_back(r.at(0));
-            return all;
-        };
         chunkExchange X = planChunks<D>(chunkSources<D>{nRanks_, me_, nc_, omegaPerNode_, L_.view, ownToView_,
-            L_.tilesFrom, L_.tilesTo, asked_, read, ownOmega_, omegaFrom_, L_.invOmega, gatherLoads});
+            L_.tilesFrom, L_.tilesTo, asked_, read, ownOmega_, omegaFrom_, L_.invOmega, comm_});
         bool take = true;
         if (mode_ == params::exchangeMode::automatic)
         {
