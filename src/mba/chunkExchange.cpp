@@ -89,6 +89,12 @@ void maskedRuns(std::int64_t id, int n0, int nodes, const std::function<bool(int
     }
 }
 
+/// Whether contributor c is in a node's set of contributors (bits, 64 a word)
+inline bool inSet(const std::uint64_t* set, std::int64_t c)
+{
+    return (set[c/64] >> (c % 64) & 1) != 0;
+}
+
 } // namespace
 
 void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const std::vector<std::uint64_t>& reach,
@@ -108,7 +114,7 @@ void nodeOwners(const int* C, std::int64_t m, int npt, std::uint64_t key, const 
         while (e < npt && std::equal(set(order[g]), set(order[g]) + words, set(order[e]))) ++e;
         members.clear();
         for (std::int64_t c = 0; c < m; ++c)
-            if (set(order[g])[c/64] >> (c % 64) & 1) members.push_back(int(c));
+            if (inSet(&reach[std::size_t(order[g])*words], c)) members.push_back(int(c));
         const std::int64_t s = std::int64_t(members.size()), size = e - g;
         if (s == 0) { g = e; continue; }
         std::rotate(members.begin(), members.begin() + std::ptrdiff_t(key % std::uint64_t(s)), members.end());
@@ -182,7 +188,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
             if (!(in.read[id] >> n & 1)) continue;
             bool other = false;
             for (std::int64_t c = 0; c < m && !other; ++c)
-                other = C[c] != in.me && (reach[n*words + c/64] >> (c % 64) & 1);
+                other = C[c] != in.me && inSet(&reach[n*words], c);
             load += other;
         }
     }
@@ -206,7 +212,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
         // whether contributor c's partial omega is positive at node n (asked
         // only where m > 1: a tile's sole contributor sums it all and sends
         // no partial sum)
-        const auto weighs = [&](std::int64_t c, int n) { return (reach[n*words + c/64] >> (c % 64) & 1) != 0; };
+        const auto weighs = [&](std::int64_t c, int n) { return inSet(&reach[n*words], c); };
         for (int n0 = 0, e = 1; n0 < npt; n0 = e++)
         {
             while (e < npt && by[e] == by[n0]) ++e;
