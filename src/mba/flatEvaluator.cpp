@@ -167,7 +167,6 @@ template <int D>
 void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine, int nRanks)
 {
     flatLevel_ = -1;
-    flatPhi_.clear();
     if (eval_.size() == 0) return;
     const int m = chooseFlatLevel(nLevels);
     if (m < 0) return;
@@ -216,7 +215,10 @@ void flatEvaluator<D>::foldLevels(const std::deque<levelPlan<D>>& levels, int m,
 template <int D>
 void flatEvaluator<D>::addAffine(const indexBox<D>& b, const affineFit<D>& affine)
 {
-    flatPhi_.assign(std::size_t(boxNodes<D>(b))*nc_, 0.0);
+    // (flatPhi_ keeps its size: refine() reads only the box's values)
+    const std::size_t n = std::size_t(boxNodes<D>(b))*nc_;
+    if (flatPhi_.size() < n) flatPhi_.resize(n);
+    std::fill_n(flatPhi_.begin(), n, 0.0);
     forEachIndex<D>(b, [&](const index<D>& j) {
         double x[D];
         for (int d = 0; d < D; ++d) x[d] = dom_.lo[d] + double(j[d] - 1)*dom_.h0;

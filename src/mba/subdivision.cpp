@@ -17,6 +17,33 @@ inline int parents(std::int64_t jf, std::int64_t lo, std::int64_t hi, std::int64
     return n;
 }
 
+/// One direction's pass: t[o][jf][i] = the sum over q of pw[3 jf + q]
+/// g[o][pj[3 jf + q]][i] (i < inner, nc-wide at compile time where inner
+/// is nc: the last direction's pass, whose rows are a node each)
+template <int NC>
+void refinePass(double* t, const double* g, std::int64_t outer, std::int64_t nf, std::int64_t nco,
+                std::int64_t inner, const std::int64_t* pj, const double* pw)
+{
+    const std::int64_t n = NC > 0 ? NC : inner;
+    for (std::int64_t o = 0; o < outer; ++o, t += nf*n, g += nco*n)
+        for (std::int64_t jf = 0; jf < nf; ++jf)
+        {
+            double* tj = t + jf*n;
+            const double* g0 = g + pj[3*jf]*n;
+            const double* g1 = g + pj[3*jf + 1]*n;
+            const double* g2 = g + pj[3*jf + 2]*n;
+            const double w0 = pw[3*jf], w1 = pw[3*jf + 1], w2 = pw[3*jf + 2];
+            for (std::int64_t i = 0; i < n; ++i) tj[i] = w0*g0[i] + w1*g1[i] + w2*g2[i];
+        }
+}
+
+/// v holds at least n values (kept when it holds more: no values written
+/// that the pass then overwrites)
+void holdAtLeast(hugeVector<double>& v, std::size_t n)
+{
+    if (v.size() < n) v.resize(n);
+}
+
 } // namespace
 
 template <int D>
@@ -41,17 +68,10 @@ void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb,
             const int np = parents(fb.lo[d] + jf, cb.lo[d], cb.hi[d], &pj[3*jf], &pw[3*jf]);
             for (int q = 0; q < np; ++q) pj[3*jf + q] -= cb.lo[d];
         }
-        T.resize(std::size_t(outer*nf*inner));
-        for (std::int64_t o = 0; o < outer; ++o)
-            for (std::int64_t jf = 0; jf < nf; ++jf)
-            {
-                double* t = &T[(o*nf + jf)*inner];
-                const double* g0 = &G[(o*nco + pj[3*jf])*inner];
-                const double* g1 = &G[(o*nco + pj[3*jf + 1])*inner];
-                const double* g2 = &G[(o*nco + pj[3*jf + 2])*inner];
-                const double w0 = pw[3*jf], w1 = pw[3*jf + 1], w2 = pw[3*jf + 2];
-                for (std::int64_t i = 0; i < inner; ++i) t[i] = w0*g0[i] + w1*g1[i] + w2*g2[i];
-            }
+        holdAtLeast(T, std::size_t(outer*nf*inner));
+        const auto pass = inner == 1 ? refinePass<1> : inner == 2 ? refinePass<2> : inner == 3 ? refinePass<3>
+                                                                                               : refinePass<0>;
+        pass(T.data(), G.data(), outer, nf, nco, inner, pj.data(), pw.data());
         n[d] = nf;
         G.swap(T);
     }

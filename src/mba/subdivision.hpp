@@ -13,7 +13,9 @@ namespace mba {
 /// Values G (nc per node, the last direction fastest) on the node box cb of
 /// one level, refined to the next level on the node box fb, one direction at
 /// a time (the parents of fb's nodes that the stencils of points inside the
-/// boxes use lie in cb). T: scratch, swapped with G
+/// boxes use lie in cb). G holds at least cb's values (more are ignored),
+/// on return at least fb's; T: scratch, swapped with G. Neither array
+/// shrinks, so that refining the same boxes again writes no zeros first.
 template <int D>
 void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, hugeVector<double>& T);
 
