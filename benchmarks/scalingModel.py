@@ -5,7 +5,9 @@
 
 RECORDS are files with mbaScaling's RESULT lines (benchmarks/scaling writes
 them): per rank count and decomposition, the busiest rank's work (thread CPU
-time of its fit and evaluation, less the simulated communicator's own time)
+time of its fit and evaluation, less the communicator's own time; with
+mbaScaling --replay, as benchmarks/scaling runs it, each rank replayed alone
+on a core, its communication answered as the simulated run answered it)
 and what it receives per step (bytes, messages), the exchange rounds and
 all-gathers of a step.
 
@@ -13,7 +15,7 @@ The model of one step on P ranks:
 
     T(P) = W(P) + R alpha + M o + B / beta + (G + S) 2 ceil(log2 P) alpha
 
-W: the busiest rank's work (fit and evaluation), measured on simulated ranks; R: exchange rounds
+W: the busiest rank's work (fit and evaluation), measured alone (above); R: exchange rounds
 (one a direct level, two a chunked one, 2 log2 P a tree one, two more where P
 is not a power of two; each a latency alpha, its messages in flight
 together); M, B: messages and bytes the busiest rank receives (o: the
@@ -73,8 +75,11 @@ NETWORKS = {
 
 
 def read_records(paths):
-    """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines"""
-    out = defaultdict(dict)
+    """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines; a
+    rank count recorded more than once counts by its record of median work
+    (benchmarks/scaling measures one rank three times: every efficiency's
+    baseline)"""
+    runs = defaultdict(lambda: defaultdict(list))
     for path in paths:
         with open(path) as f:
             for line in f:
@@ -87,7 +92,12 @@ def read_records(paths):
                         rec[k] = float(v)
                     except ValueError:
                         rec[k] = v
-                out[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])] = rec
+                runs[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])].append(rec)
+    out = defaultdict(dict)
+    for key, byRanks in runs.items():
+        for P, recs in byRanks.items():
+            recs = sorted(recs, key=lambda r: r["work_max"])
+            out[key][P] = recs[(len(recs) - 1)//2]
     return out
 
 

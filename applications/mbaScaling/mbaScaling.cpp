@@ -3,7 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
-//              [--control owner|balanced]
+//              [--control owner|balanced] [--replay]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -24,7 +24,8 @@
 // control points: prescribed, not evaluated, as in the motion solver).
 //
 // Per rank count: the plan and a first fit, then a step measured (a fit
-// through the plan with new values, and the evaluation; the mean of --steps). Per rank: its control
+// through the plan with new values, and the evaluation; the median of --steps, whose CPU times
+// can hold a stall of the kernel's, such as a huge page's compaction). Per rank: its control
 // and evaluation points, its neighbours (ranks it shares points with), what it
 // receives point-to-point in the step (bytes, messages), what the step's
 // collectives cost it, and the CPU time of its fit and evaluation (thread CPU
@@ -36,10 +37,25 @@
 // (lowerBoundBytes), against the share (with --levels, per level too);
 // --exchange the levels' exchange (params::exchange; default automatic, the
 // motion solver's).
+//
+// --replay measures the ranks' fit and evaluation again, each rank alone:
+// the simulated ranks record what each rank's communication returned, and
+// each rank then runs once more by itself in the main thread, its
+// communicator handing it those results in the same order (the algorithm is
+// deterministic: each all-gather checks that the rank's own part is what it
+// was). Its work is then measured as on a core of its own, as a real rank
+// runs: on the simulated ranks many threads share two cores, and each
+// finds its caches emptied by the others whenever it waits for them (every
+// exchange and all-gather), and their allocations contend. The plan and
+// the figures of the communication are the simulated run's; the RESULT line
+// adds the simulated ranks' work (simulated_work_max, _mean).
 
 #include "multilevel.hpp"
 
 #include <time.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -67,6 +83,7 @@ struct options
     int steps = 1;
     params::exchangeMode exchange = params::exchangeMode::automatic;
     bool balanced = false;   ///< --control balanced
+    bool replay = false;     ///< --replay
 };
 
 [[noreturn]] void usage(const std::string& msg)
@@ -77,7 +94,7 @@ struct options
     os <<
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
-        "                  [--control owner|balanced]\n";
+        "                  [--control owner|balanced] [--replay]\n";
     std::exit(msg.empty() ? 0 : 2);
 }
 
@@ -123,6 +140,7 @@ options parse(int argc, char** argv)
             else if (a == "--decomposition") o.decomposition = val();
             else if (a == "--levels") o.levels = true;
             else if (a == "--lower-bound") o.lowerBound = true;
+            else if (a == "--replay") o.replay = true;
             else if (a == "--steps") o.steps = std::stoi(val());
             else if (a == "--exchange")
             {
@@ -169,11 +187,24 @@ double threadSeconds()
 /// A simulated rank's communicator that counts the thread CPU time spent in
 /// it: what the simulation costs (copies, barriers of threads that share
 /// two cores), which a network replaces; the rank's work is the rest
+/// What one rank's communication returned, call after call (--replay)
+struct callLog
+{
+    std::vector<std::vector<bytes>> calls;   ///< per call: what came from each rank (one entry: a round's)
+    std::size_t next = 0;                    ///< the next call to replay
+};
+
 class timedCommunicator : public communicator
 {
     const communicator& inner_;
+    callLog* log_;   ///< records every call's results (null: none)
     mutable double seconds_ = 0;
     mutable long gathers_ = 0, exchanges_ = 0;
+
+    void record(std::vector<bytes> got) const
+    {
+        if (log_) log_->calls.push_back(std::move(got));
+    }
 
     template <class F>
     auto timed(F f) const -> decltype(f())
@@ -188,12 +219,16 @@ protected:
     std::vector<bytes> allGatherBytes(const bytes& mine) const override
     {
         ++gathers_;
-        return timed([&] { return inner_.allGather(mine); });
+        std::vector<bytes> all = timed([&] { return inner_.allGather(mine); });
+        record(all);
+        return all;
     }
     std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const override
     {
         ++exchanges_;
-        return timed([&] { return inner_.exchange(send); });
+        std::vector<bytes> got = timed([&] { return inner_.exchange(send); });
+        record(got);
+        return got;
     }
     void exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const override
     {
@@ -207,6 +242,12 @@ protected:
             for (int r = 0; r < size(); ++r) if (recv[r].size) std::memcpy(recv[r].data, got[r].data(), recv[r].size);
             return 0;
         });
+        if (log_)
+        {
+            std::vector<bytes> got(size());
+            for (int r = 0; r < size(); ++r) got[r].assign(recv[r].data, recv[r].data + recv[r].size);
+            record(std::move(got));
+        }
     }
 
     void sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const override
@@ -218,15 +259,54 @@ protected:
             inner_.sendReceive(to, send.data, send.size, from, recv.data, recv.size);
             return 0;
         });
+        if (log_) record({bytes(recv.data, recv.data + recv.size)});
     }
 
 public:
-    explicit timedCommunicator(const communicator& inner) : inner_(inner) {}
+    explicit timedCommunicator(const communicator& inner, callLog* log = nullptr) : inner_(inner), log_(log) {}
     int rank() const override { return inner_.rank(); }
     int size() const override { return inner_.size(); }
     double seconds() const { return seconds_; }
     long gathers() const { return gathers_; }
     long exchanges() const { return exchanges_; }
+};
+
+/// Rank r of P alone, its communication answered from a callLog (--replay)
+class replayCommunicator : public communicator
+{
+    const int rank_, size_;
+    callLog& log_;
+
+    const std::vector<bytes>& next() const
+    {
+        if (log_.next >= log_.calls.size()) throw std::logic_error("mbaScaling: the replay makes more calls than the run");
+        return log_.calls[log_.next++];
+    }
+    static void copy(const bytes& from, byteRange to)
+    {
+        if (from.size() != to.size) throw std::logic_error("mbaScaling: the replay expects other sizes than the run");
+        if (to.size) std::memcpy(to.data, from.data(), to.size);
+    }
+
+protected:
+    std::vector<bytes> allGatherBytes(const bytes& mine) const override
+    {
+        const std::vector<bytes>& all = next();
+        if (all.at(rank_) != mine) throw std::logic_error("mbaScaling: the replay departs from the run");
+        return all;
+    }
+    std::vector<bytes> exchangeBytes(const std::vector<bytes>&) const override { return next(); }
+    void exchangeInPlace(const std::vector<constByteRange>&, const std::vector<byteRange>& recv) const override
+    {
+        const std::vector<bytes>& got = next();
+        for (int r = 0; r < size_; ++r) if (r != rank_) copy(got.at(r), recv[r]);
+    }
+    void sendReceiveBytes(int, constByteRange, int, byteRange recv) const override { copy(next().at(0), recv); }
+
+public:
+    replayCommunicator(int r, int P, callLog& log) : rank_(r), size_(P), log_(log) {}
+    int rank() const override { return rank_; }
+    int size() const override { return size_; }
 };
 
 /// The twisted cube's top and bottom at t = 1: displacement of the point x
@@ -339,8 +419,17 @@ struct rankFigures
     double control = 0, evaluation = 0, neighbours = 0;
     double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
+    double simulatedWork = 0;   ///< --replay: fitCpu + evalCpu as the simulated ranks measured them
     std::vector<double> lowerBound;   ///< lowerBoundBytes, per level
 };
+
+/// The median of v (the mean of the middle two where even)
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    const std::size_t h = v.size()/2;
+    return v.size() % 2 ? v[h] : 0.5*(v[h - 1] + v[h]);
+}
 
 /// First index of part p of n cells in m parts, and the point range of the part
 long first(int p, long n, int m) { return long(p)*n/m; }
@@ -364,8 +453,9 @@ rankResult runRanks(const options& o, int P)
     rankResult res;
     res.ranks.resize(P);
     std::mutex mtx;
-    runSimulated(P, [&](const communicator& simulated) {
-        const timedCommunicator comm(simulated);
+    // rank comm.rank(): its points, the plan, the measured steps (replayed:
+    // its figures only)
+    auto runRank = [&](const timedCommunicator& comm, bool replayed) {
         const int r = comm.rank();
         const std::array<int, 3> pr{r % m[0], (r/m[0]) % m[1], r/(m[0]*m[1])};
         std::array<long, 3> lo, hi;
@@ -434,22 +524,25 @@ rankResult runRanks(const options& o, int P)
         mba.evaluate(out);
         f.planCpu = threadSeconds() - t;
 
-        // the step: a fit through the plan, the evaluation (the mean of --steps)
+        // the step: a fit through the plan, the evaluation (the median of --steps)
         const trafficStats before = comm.traffic();
         const long gathers0 = comm.gathers(), exchanges0 = comm.exchanges();
+        std::vector<double> fitSteps, evalSteps;
         for (int step = 0; step < o.steps; ++step)
         {
             double c = comm.seconds();
             t = threadSeconds();
             mba.fit(step % 2 ? v1 : v2);
-            f.fitCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
+            fitSteps.push_back(threadSeconds() - t - (comm.seconds() - c));
             c = comm.seconds();
             t = threadSeconds();
             mba.evaluate(out);
-            f.evalCpu += (threadSeconds() - t - (comm.seconds() - c))/o.steps;
+            evalSteps.push_back(threadSeconds() - t - (comm.seconds() - c));
         }
+        f.fitCpu = median(fitSteps);
+        f.evalCpu = median(evalSteps);
         const fitReport& rep = mba.report();
-        if (P > 1 && o.lowerBound)
+        if (P > 1 && o.lowerBound && !replayed)
         {
             std::vector<point<3>> query(ctrl);
             query.insert(query.end(), eval.begin(), eval.end());
@@ -461,6 +554,7 @@ rankResult runRanks(const options& o, int P)
         f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes)/o.steps;
         f.gathers = double(comm.gathers() - gathers0)/o.steps;
         f.exchanges = double(comm.exchanges() - exchanges0)/o.steps;
+        if (replayed) return f;
 
         std::lock_guard<std::mutex> lock(mtx);
         res.ranks[r] = f;
@@ -469,7 +563,24 @@ rankResult runRanks(const options& o, int P)
         const bool busiest = std::none_of(res.ranks.begin(), res.ranks.end(),
                                           [&](const rankFigures& g) { return g.bytes > f.bytes; });
         if (busiest) { res.busiestLevels = mba.stats(); res.busiestLeast = f.lowerBound; }
+        return f;
+    };
+    std::vector<callLog> logs(o.replay ? P : 0);
+    runSimulated(P, [&](const communicator& simulated) {
+        runRank(timedCommunicator(simulated, o.replay ? &logs[simulated.rank()] : nullptr), false);
     });
+    for (int r = 0; r < P && o.replay; ++r)
+    {
+        const replayCommunicator alone(r, P, logs[r]);
+        const rankFigures f = runRank(timedCommunicator(alone), true);
+        if (logs[r].next != logs[r].calls.size())
+            throw std::logic_error("mbaScaling: the replay makes fewer calls than the run");
+        res.ranks[r].simulatedWork = res.ranks[r].fitCpu + res.ranks[r].evalCpu;
+        res.ranks[r].fitCpu = f.fitCpu;
+        res.ranks[r].evalCpu = f.evalCpu;
+        res.ranks[r].planCpu = f.planCpu;
+        std::vector<std::vector<bytes>>().swap(logs[r].calls);
+    }
     return res;
 }
 
@@ -491,6 +602,13 @@ summary over(const std::vector<rankFigures>& v, F get)
 int main(int argc, char** argv)
 {
     const options o = parse(argc, argv);
+#ifdef __GLIBC__
+    // Large arrays always in fresh mappings: glibc raises this threshold as
+    // such arrays are freed, and later ones (another rank count's, the
+    // replay's) would then come from the heap, and run slower (8M cells on
+    // one rank: the fit 0.16 s in the first run, 0.20 s in the replay)
+    mallopt(M_MMAP_THRESHOLD, 128*1024);
+#endif
     const long n = o.n;
     const long nControl = 2*(n + 1)*(n + 1);
     std::printf("mbaScaling: twisted cube, %ld^3 cells, %ld control points (top and bottom), %ld evaluated points, "
@@ -521,6 +639,7 @@ int main(int argc, char** argv)
             const summary ev = over(v, [](const rankFigures& f) { return f.evalCpu; });
             const summary work = over(v, [](const rankFigures& f) { return f.fitCpu + f.evalCpu; });
             const summary plan = over(v, [](const rankFigures& f) { return f.planCpu; });
+            const summary simulated = over(v, [](const rankFigures& f) { return f.simulatedWork; });
             const summary bound = over(v, [](const rankFigures& f) {
                 return std::accumulate(f.lowerBound.begin(), f.lowerBound.end(), 0.0);
             });
@@ -539,11 +658,13 @@ int main(int argc, char** argv)
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
-                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f\n",
+                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f work_measured=%s%s\n",
                         n, o.decomposition.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
-                        res.maxResidual, bound.max);
+                        res.maxResidual, bound.max, o.replay ? "alone" : "simulated",
+                        o.replay ? (" simulated_work_max=" + std::to_string(simulated.max) + " simulated_work_mean="
+                                    + std::to_string(simulated.mean)).c_str() : "");
             if (o.lowerBound && P > 1)
                 std::printf("  least any exchange of values per level could make the busiest rank receive: %.0f bytes, "
                             "%.2f x the share\n", bound.max, bound.max/share);
