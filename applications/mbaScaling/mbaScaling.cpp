@@ -184,9 +184,6 @@ double threadSeconds()
     return double(t.tv_sec) + 1e-9*double(t.tv_nsec);
 }
 
-/// A simulated rank's communicator that counts the thread CPU time spent in
-/// it: what the simulation costs (copies, barriers of threads that share
-/// two cores), which a network replaces; the rank's work is the rest
 /// What one rank's communication returned, call after call (--replay)
 struct callLog
 {
@@ -194,6 +191,10 @@ struct callLog
     std::size_t next = 0;                    ///< the next call to replay
 };
 
+/// A simulated rank's communicator that counts the thread CPU time spent in
+/// it: what the simulation costs (copies, barriers of threads that share
+/// two cores), which a network replaces; the rank's work is the rest. With
+/// a log, it records what every call returned.
 class timedCommunicator : public communicator
 {
     const communicator& inner_;
