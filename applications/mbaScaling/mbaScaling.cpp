@@ -202,9 +202,10 @@ class timedCommunicator : public communicator
     mutable double seconds_ = 0;
     mutable long gathers_ = 0, exchanges_ = 0;
 
-    void record(std::vector<bytes> got) const
+    /// (inside timed(): the copies are the simulation's, not the rank's work)
+    void record(const std::vector<bytes>& got) const
     {
-        if (log_) log_->calls.push_back(std::move(got));
+        if (log_) log_->calls.push_back(got);
     }
 
     template <class F>
@@ -220,16 +221,20 @@ protected:
     std::vector<bytes> allGatherBytes(const bytes& mine) const override
     {
         ++gathers_;
-        std::vector<bytes> all = timed([&] { return inner_.allGather(mine); });
-        record(all);
-        return all;
+        return timed([&] {
+            std::vector<bytes> all = inner_.allGather(mine);
+            record(all);
+            return all;
+        });
     }
     std::vector<bytes> exchangeBytes(const std::vector<bytes>& send) const override
     {
         ++exchanges_;
-        std::vector<bytes> got = timed([&] { return inner_.exchange(send); });
-        record(got);
-        return got;
+        return timed([&] {
+            std::vector<bytes> got = inner_.exchange(send);
+            record(got);
+            return got;
+        });
     }
     void exchangeInPlace(const std::vector<constByteRange>& send, const std::vector<byteRange>& recv) const override
     {
@@ -241,14 +246,9 @@ protected:
             for (int r = 0; r < size(); ++r) if (send[r].size) b[r].assign(send[r].data, send[r].data + send[r].size);
             const std::vector<bytes> got = inner_.exchange(b);
             for (int r = 0; r < size(); ++r) if (recv[r].size) std::memcpy(recv[r].data, got[r].data(), recv[r].size);
+            record(got);
             return 0;
         });
-        if (log_)
-        {
-            std::vector<bytes> got(size());
-            for (int r = 0; r < size(); ++r) got[r].assign(recv[r].data, recv[r].data + recv[r].size);
-            record(std::move(got));
-        }
     }
 
     void sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const override
@@ -258,9 +258,9 @@ protected:
         // through an exchange with every rank, whose set-up is theirs too)
         timed([&] {
             inner_.sendReceive(to, send.data, send.size, from, recv.data, recv.size);
+            if (log_) record({bytes(recv.data, recv.data + recv.size)});
             return 0;
         });
-        if (log_) record({bytes(recv.data, recv.data + recv.size)});
     }
 
 public:
