@@ -215,9 +215,8 @@ void flatEvaluator<D>::foldLevels(const std::deque<levelPlan<D>>& levels, int m,
 template <int D>
 void flatEvaluator<D>::addAffine(const indexBox<D>& b, const affineFit<D>& affine)
 {
-    // (flatPhi_ keeps its size: refine() reads only the box's values)
     const std::size_t n = std::size_t(boxNodes<D>(b))*nc_;
-    if (flatPhi_.size() < n) flatPhi_.resize(n);
+    holdAtLeast(flatPhi_, n);
     std::fill_n(flatPhi_.begin(), n, 0.0);
     forEachIndex<D>(b, [&](const index<D>& j) {
         double x[D];

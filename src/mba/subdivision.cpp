@@ -37,13 +37,6 @@ void refinePass(double* t, const double* g, std::int64_t outer, std::int64_t nf,
         }
 }
 
-/// v holds at least n values (kept when it holds more: no values written
-/// that the pass then overwrites)
-void holdAtLeast(hugeVector<double>& v, std::size_t n)
-{
-    if (v.size() < n) v.resize(n);
-}
-
 } // namespace
 
 template <int D>

@@ -19,5 +19,12 @@ namespace mba {
 template <int D>
 void refine(hugeVector<double>& G, const indexBox<D>& cb, const indexBox<D>& fb, int nc, hugeVector<double>& T);
 
+/// v holds at least n values (kept when it holds more: an array that refine()
+/// works in grows once, and is not filled with zeros again in every fit)
+inline void holdAtLeast(hugeVector<double>& v, std::size_t n)
+{
+    if (v.size() < n) v.resize(n);
+}
+
 } // namespace mba
 #endif
