@@ -195,6 +195,7 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
                     << " tiles own/view " << s.ownTiles << '/' << s.viewTiles
                     << (s.dense ? " dense" : " sparse") << (s.separated ? " separated" : "")
                     << (s.chunked ? " chunked" : "") << (s.tree ? " tree" : "")
+                    << " lone points " << s.lonePoints << ", " << s.bytes/1048576.0 << " MB"
                     << " received " << s.bytesReceivedPerApply
                     << " B, max residual " << s.maxResidual << ", " << s.seconds << " s (plan "
                     << s.planSeconds << " s)" << endl;
