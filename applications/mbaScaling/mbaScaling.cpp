@@ -43,7 +43,8 @@
 // each rank then runs once more by itself in the main thread, its
 // communicator handing it those results in the same order (the algorithm is
 // deterministic: each all-gather checks that the rank's own part is what it
-// was). Its work is then measured as on a core of its own, as a real rank
+// was, and the rank's evaluated values must come out the same bit for bit;
+// a departure stops the program with an error). Its work is then measured as on a core of its own, as a real rank
 // runs: on the simulated ranks many threads share two cores, and each
 // finds its caches emptied by the others whenever it waits for them (every
 // exchange and all-gather), and their allocations contend. The plan and
@@ -60,6 +61,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <cstdio>
 #include <iostream>
@@ -421,8 +423,18 @@ struct rankFigures
     double bytes = 0, messages = 0, collectiveBytes = 0, gathers = 0, exchanges = 0;
     double fitCpu = 0, evalCpu = 0, planCpu = 0;
     double simulatedWork = 0;   ///< --replay: fitCpu + evalCpu as the simulated ranks measured them
+    std::uint64_t valuesHash = 0;     ///< of the last evaluation's values (the replay must give the same bits)
     std::vector<double> lowerBound;   ///< lowerBoundBytes, per level
 };
+
+/// FNV-1a of the bytes of v
+std::uint64_t hashOf(const std::vector<double>& v)
+{
+    std::uint64_t h = 14695981039346656037ull;
+    const unsigned char* b = reinterpret_cast<const unsigned char*>(v.data());
+    for (std::size_t i = 0; i < v.size()*sizeof(double); ++i) h = (h ^ b[i])*1099511628211ull;
+    return h;
+}
 
 /// The median of v (the mean of the middle two where even)
 double median(std::vector<double> v)
@@ -555,6 +567,7 @@ rankResult runRanks(const options& o, int P)
         f.collectiveBytes = double(after.collectiveBytes - before.collectiveBytes)/o.steps;
         f.gathers = double(comm.gathers() - gathers0)/o.steps;
         f.exchanges = double(comm.exchanges() - exchanges0)/o.steps;
+        f.valuesHash = hashOf(out);
         if (replayed) return f;
 
         std::lock_guard<std::mutex> lock(mtx);
@@ -576,6 +589,8 @@ rankResult runRanks(const options& o, int P)
         const rankFigures f = runRank(timedCommunicator(alone), true);
         if (logs[r].next != logs[r].calls.size())
             throw std::logic_error("mbaScaling: the replay makes fewer calls than the run");
+        if (f.valuesHash != res.ranks[r].valuesHash)
+            throw std::logic_error("mbaScaling: the replay's values differ from the run's");
         res.ranks[r].simulatedWork = res.ranks[r].fitCpu + res.ranks[r].evalCpu;
         res.ranks[r].fitCpu = f.fitCpu;
         res.ranks[r].evalCpu = f.evalCpu;
@@ -659,7 +674,7 @@ int main(int argc, char** argv)
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
-                        "plan_cpu_max=%.4f max_residual=%.3e lower_bound_max=%.0f work_measured=%s%s\n",
+                        "plan_cpu_max=%.4f max_residual=%.17g lower_bound_max=%.0f work_measured=%s%s\n",
                         n, o.decomposition.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
