@@ -193,8 +193,7 @@ chunkExchange planChunks(const chunkSources<D>& in)
         }
     }
     // every rank's load (collective: every rank plans its chunks)
-    std::vector<std::int64_t> loads;
-    for (const auto& r : in.comm.allGather(std::vector<std::int64_t>{load*in.nc})) loads.push_back(r.at(0));
+    const std::vector<std::int64_t> loads = in.comm.allGatherFixed(std::vector<std::int64_t>{load*in.nc});
     for (const std::int64_t id : T.byKey)
     {
         const int* C = &T.contributors[T.cBegin[id]];

@@ -12,27 +12,25 @@ namespace mba {
 
 std::vector<double> communicator::sum(const std::vector<double>& mine) const
 {
-    const auto all = allGather(mine);
-    std::vector<double> s(mine.size(), 0.0);
-    for (const auto& v : all)
-    {
-        if (v.size() != s.size()) throw collectiveError("mba: sum over ranks of arrays of different sizes");
-        for (std::size_t i = 0; i < s.size(); ++i) s[i] += v[i];
-    }
+    const std::vector<double> all = allGatherFixed(mine);
+    const std::size_t n = mine.size();
+    std::vector<double> s(n, 0.0);
+    for (std::size_t at = 0; at < all.size(); at += n)
+        for (std::size_t i = 0; i < n; ++i) s[i] += all[at + i];
     return s;
 }
 
 double communicator::max(double x) const
 {
     double m = x;
-    for (const auto& v : allGather(std::vector<double>{x})) m = std::max(m, v[0]);
+    for (const double v : allGatherFixed(std::vector<double>{x})) m = std::max(m, v);
     return m;
 }
 
 std::int64_t communicator::sum(std::int64_t x) const
 {
     std::int64_t s = 0;
-    for (const auto& v : allGather(std::vector<std::int64_t>{x})) s += v[0];
+    for (const std::int64_t v : allGatherFixed(std::vector<std::int64_t>{x})) s += v;
     return s;
 }
 

@@ -87,6 +87,28 @@ public:
         return out;
     }
 
+    /// allGather of the same number of values from every rank, as one
+    /// array: rank r's n = mine.size() values at [r n, (r + 1) n). One
+    /// array, not one a rank: for the few values a rank adds to a sum or
+    /// a maximum. Throws collectiveError where the ranks' sizes differ
+    template <class T>
+    std::vector<T> allGatherFixed(const std::vector<T>& mine) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        const std::size_t nb = mine.size()*sizeof(T);
+        bytes b(nb);
+        if (nb) std::memcpy(b.data(), mine.data(), nb);
+        traffic_.collectiveBytes += nb;
+        const std::vector<bytes> all = allGatherBytes(b);
+        std::vector<T> out(all.size()*mine.size());
+        for (std::size_t r = 0; r < all.size(); ++r)
+        {
+            if (all[r].size() != nb) throw collectiveError("mba: an all-gather of arrays of different sizes");
+            if (nb) std::memcpy(reinterpret_cast<char*>(out.data()) + r*nb, all[r].data(), nb);
+        }
+        return out;
+    }
+
     template <class T>
     std::vector<std::vector<T>> exchange(const std::vector<std::vector<T>>& send) const
     {

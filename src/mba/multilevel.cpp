@@ -107,8 +107,13 @@ void multilevel<D>::state::findDomain(const box<D>* bounds)
     for (std::size_t i = 0; i < eval.x.size; ++i) b.add(eval.x[i]);
     std::vector<double> mm(2*D);
     for (int d = 0; d < D; ++d) { mm[d] = b.lo[d]; mm[D + d] = -b.hi[d]; }
-    for (const auto& v : comm.allGather(mm))
-        for (int d = 0; d < D; ++d) { b.lo[d] = std::min(b.lo[d], v[d]); b.hi[d] = std::max(b.hi[d], -v[D + d]); }
+    const std::vector<double> g = comm.allGatherFixed(mm);
+    for (std::size_t at = 0; at < g.size(); at += 2*D)
+        for (int d = 0; d < D; ++d)
+        {
+            b.lo[d] = std::min(b.lo[d], g[at + d]);
+            b.hi[d] = std::max(b.hi[d], -g[at + D + d]);
+        }
     if (bounds)
     {
         collectively(comm, [&] {
@@ -221,11 +226,12 @@ void multilevel<D>::state::residualStats(double& maxr, double& rms) const
     // one all-gather for the maximum and the sums (added in rank order, as comm.sum)
     maxr = std::max(std::max(m[0], m[1]), std::max(m[2], m[3]));
     double sn[2] = {0, 0};
-    for (const auto& v : comm.allGather(std::vector<double>{maxr, (s[0] + s[1]) + (s[2] + s[3]), n}))
+    const std::vector<double> g = comm.allGatherFixed(std::vector<double>{maxr, (s[0] + s[1]) + (s[2] + s[3]), n});
+    for (std::size_t at = 0; at < g.size(); at += 3)
     {
-        maxr = std::max(maxr, v[0]);
-        sn[0] += v[1];
-        sn[1] += v[2];
+        maxr = std::max(maxr, g[at]);
+        sn[0] += g[at + 1];
+        sn[1] += g[at + 2];
     }
     rms = sn[1] > 0 ? std::sqrt(sn[0]/sn[1]) : 0.0;
 }
