@@ -67,6 +67,18 @@ protected:
     /// return at once. By default through exchangeInPlace.
     virtual void sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const;
 
+private:
+    /// Every rank's values as bytes (counted as collective traffic)
+    template <class T>
+    std::vector<bytes> allGatherOf(const std::vector<T>& mine) const
+    {
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        bytes b(mine.size()*sizeof(T));
+        if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
+        traffic_.collectiveBytes += b.size();
+        return allGatherBytes(b);
+    }
+
 public:
     virtual ~communicator() = default;
     virtual int rank() const = 0;
@@ -77,11 +89,7 @@ public:
     template <class T>
     std::vector<std::vector<T>> allGather(const std::vector<T>& mine) const
     {
-        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
-        bytes b(mine.size()*sizeof(T));
-        if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
-        traffic_.collectiveBytes += b.size();
-        const std::vector<bytes> all = allGatherBytes(b);
+        const std::vector<bytes> all = allGatherOf(mine);
         std::vector<std::vector<T>> out(all.size());
         for (std::size_t r = 0; r < all.size(); ++r) out[r] = fromBytes<T>(all[r]);
         return out;
@@ -94,12 +102,8 @@ public:
     template <class T>
     std::vector<T> allGatherFixed(const std::vector<T>& mine) const
     {
-        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
         const std::size_t nb = mine.size()*sizeof(T);
-        bytes b(nb);
-        if (nb) std::memcpy(b.data(), mine.data(), nb);
-        traffic_.collectiveBytes += nb;
-        const std::vector<bytes> all = allGatherBytes(b);
+        const std::vector<bytes> all = allGatherOf(mine);
         std::vector<T> out(all.size()*mine.size());
         for (std::size_t r = 0; r < all.size(); ++r)
         {
