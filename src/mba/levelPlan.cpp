@@ -637,6 +637,33 @@ void levelPlanner<D>::fillStats()
 }
 
 template <int D>
+levelPlan<D> coefficientTiles(int k, const domain<D>& dom, const controlPoints<D>& ctrl)
+{
+    levelPlan<D> L;
+    L.level = k;
+    L.scale = std::ldexp(1.0, k);
+    L.stats.level = k;
+    L.stats.h = dom.h0/L.scale;
+    index<D> nodes;
+    for (int d = 0; d < D; ++d) nodes[d] = dom.nodes(k, d);
+    L.view.init(nodes, false);
+    ctrl.forEachStencil(L.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L.view, st); });
+    const int per = ctrl.omegaPerNode, nc = ctrl.nComponents;
+    L.coefficientNodes.assign(std::size_t(L.view.size())*per, 0);
+    stencilTiles<D> tid;
+    ctrl.forEachStencil(L.scale, [&](std::size_t i, const stencil<D>& st) {
+        findTiles(L.view, st, tid);
+        detail::visitStencil(tid, st, [&](std::int64_t id, int n, double w) {
+            // (where the plan's omega, a sum of w^2, is > 0)
+            if (!(w*w > 0)) return;
+            for (int c = 0; c < per; ++c)
+                if (per == 1 || ctrl.mask[i*nc + c]) L.coefficientNodes[id*per + c] |= std::uint64_t(1) << n;
+        });
+    });
+    return L;
+}
+
+template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
                        const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
 {
@@ -645,6 +672,8 @@ levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, co
 
 template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
 template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
+template levelPlan<2> coefficientTiles<2>(int, const domain<2>&, const controlPoints<2>&);
+template levelPlan<3> coefficientTiles<3>(int, const domain<3>&, const controlPoints<3>&);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
                                    const queryClusters<2>&, int, params::exchangeMode);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,

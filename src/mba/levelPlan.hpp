@@ -179,6 +179,15 @@ levelPlan<D> unreadLevel(const levelPlan<D>& L)
     return u;
 }
 
+/// Level k's tiles (the view) and coefficientNodes alone, from this rank's
+/// control points, with level, scale and stats.level and h: what
+/// flatEvaluator::reads asks of a level, without the plan's omega values
+/// (its largest array while it is made), exchange and runs. On one rank
+/// reads() answers for it as for the full plan: a node's omega is > 0
+/// where a point's weight there is
+template <int D>
+levelPlan<D> coefficientTiles(int k, const domain<D>& dom, const controlPoints<D>& ctrl);
+
 /// Plans level k. Collective
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,

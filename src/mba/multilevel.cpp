@@ -256,11 +256,24 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         if (k == int(s.levels.size()))
         {
             const double t1 = now();
-            s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
-                                            s.parameters.exchange));
-            levelPlan<D>& L = s.levels.back();
-            if (s.parameters.stopUnread && !(s.comm.max(s.evaluator.reads(L) ? 1.0 : 0.0) > 0)) L = unreadLevel(L);
-            L.stats.planSeconds = now() - t1;
+            // On one rank a level's control points' tiles alone say whether
+            // it is read: one that is not is never planned in full
+            bool unread = false;
+            if (s.parameters.stopUnread && s.comm.size() == 1)
+            {
+                levelPlan<D> c = coefficientTiles<D>(k, s.dom, s.ctrl);
+                unread = !s.evaluator.reads(c);
+                if (unread) s.levels.push_back(unreadLevel(c));
+            }
+            if (!unread)
+            {
+                s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
+                                                s.parameters.exchange));
+                levelPlan<D>& L = s.levels.back();
+                if (s.parameters.stopUnread && !(s.comm.max(s.evaluator.reads(L) ? 1.0 : 0.0) > 0))
+                    L = unreadLevel(L);
+            }
+            s.levels.back().stats.planSeconds = now() - t1;
         }
         if (!s.levels[k].read)
         {

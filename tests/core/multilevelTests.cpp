@@ -444,6 +444,48 @@ TEST_CASE("a fit can stop before the levels that no evaluation point reads", "[c
     stopsBeforeUnreadLevels<3>();
 }
 
+TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan's omega is > 0", "[multilevel]")
+{
+    // (what a fit on one rank asks of a new level to find it unread,
+    // without planning it): a sliding wall (a mask, one omega a component)
+    // and scattered points (one omega a node), levels 0 to 9
+    const bool masked = GENERATE(true, false);
+    const slidingWall<3> w(12);
+    const std::vector<point<3>> c = masked ? w.c : randomPoints<3>(300, 121);
+    controlPoints<3> ctrl(c, 3, masked ? w.mask : std::vector<std::uint8_t>());
+    ctrl.classify(serial());
+    box<3> b = box<3>::empty();
+    for (const point<3>& x : c) b.add(x.data());
+    const domain<3> dom = domain<3>::fromBox(b, 1, params().padding);
+    ctrl.arrange(dom);
+    REQUIRE(ctrl.omegaPerNode == (masked ? 3 : 1));
+    const int per = ctrl.omegaPerNode;
+    for (int k = 0; k < 10; ++k)
+    {
+        INFO("masked " << masked << ", level " << k);
+        const levelPlan<3> full = planLevel<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8,
+                                               params::exchangeMode::automatic);
+        const levelPlan<3> alone = coefficientTiles<3>(k, dom, ctrl);
+        REQUIRE(alone.coefficientNodes.size() == std::size_t(alone.view.size())*per);
+        std::int64_t marked = 0, differ = 0;
+        for (std::int64_t id = 0; id < full.view.size(); ++id)
+        {
+            const std::int64_t a = alone.view.findKey(full.view.keyOf(id));
+            for (int j = 0; j < per; ++j)
+            {
+                const std::uint64_t f = full.coefficientNodes[id*per + j];
+                const std::uint64_t m = a < 0 ? 0 : alone.coefficientNodes[a*per + j];
+                differ += f != m;
+                marked += f != 0;
+            }
+        }
+        CHECK(marked > 0);
+        CHECK(differ == 0);
+        // (and no tile of its own that the plan lacks)
+        for (std::int64_t a = 0; a < alone.view.size(); ++a) CHECK(full.view.findKey(alone.view.keyOf(a)) >= 0);
+    }
+}
+
 TEST_CASE("bad input gets a clear error", "[core][errors]")
 {
     auto c = randomPoints<3>(20, 51);
