@@ -636,31 +636,68 @@ void levelPlanner<D>::fillStats()
     }
 }
 
+/// Own tiles and their coefficient nodes from the control points' weights;
+/// on several ranks also those of the other ranks' tiles that this rank's
+/// query points' stencils touch (the plan's tile requests), at the nodes
+/// they read
 template <int D>
-levelPlan<D> coefficientTiles(int k, const domain<D>& dom, const controlPoints<D>& ctrl)
+levelPlan<D> levelPlanner<D>::coefficientTiles(int k)
 {
-    levelPlan<D> L;
-    L.level = k;
-    L.scale = std::ldexp(1.0, k);
-    L.stats.level = k;
-    L.stats.h = dom.h0/L.scale;
-    index<D> nodes;
-    for (int d = 0; d < D; ++d) nodes[d] = dom.nodes(k, d);
-    L.view.init(nodes, false);
-    ctrl.forEachStencil(L.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L.view, st); });
-    const int per = ctrl.omegaPerNode, nc = ctrl.nComponents;
-    L.coefficientNodes.assign(std::size_t(L.view.size())*per, 0);
+    L_.level = k;
+    L_.scale = std::ldexp(1.0, k);
+    L_.stats.level = k;
+    L_.stats.h = dom_.h0/L_.scale;
+    for (int d = 0; d < D; ++d) nodes_[d] = dom_.nodes(k, d);
+    collectively(comm_, [&] { L_.ownLayout.init(nodes_, false); });
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L_.ownLayout, st); });
+    nOwn_ = L_.ownLayout.size();
+    const int per = omegaPerNode_;
+    std::vector<std::uint64_t>& mask = L_.coefficientNodes;
+    mask.assign(std::size_t(nOwn_)*per, 0);
     stencilTiles<D> tid;
-    ctrl.forEachStencil(L.scale, [&](std::size_t i, const stencil<D>& st) {
-        findTiles(L.view, st, tid);
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
+        findTiles(L_.ownLayout, st, tid);
         detail::visitStencil(tid, st, [&](std::int64_t id, int n, double w) {
             // (where the plan's omega, a sum of w^2, is > 0)
             if (!(w*w > 0)) return;
             for (int c = 0; c < per; ++c)
-                if (per == 1 || ctrl.mask[i*nc + c]) L.coefficientNodes[id*per + c] |= std::uint64_t(1) << n;
+                if (per == 1 || ctrl_.mask[i*nc_ + c]) mask[id*per + c] |= std::uint64_t(1) << n;
         });
     });
-    return L;
+    if (nRanks_ == 1)
+    {
+        L_.view = std::move(L_.ownLayout);
+        return std::move(L_);
+    }
+    // the tiles asked for (as the plan asks), answered with their masks at
+    // the nodes asked: key, then per omega value its nodes
+    const std::vector<std::vector<std::uint64_t>> wanted = comm_.exchange(tileRequests(bucketDirectory()));
+    std::vector<std::vector<std::uint64_t>> answer(nRanks_);
+    for (int r = 0; r < nRanks_; ++r)
+        for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
+        {
+            const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
+            if (id < 0) continue;
+            answer[r].push_back(wanted[r][j]);
+            for (int c = 0; c < per; ++c) answer[r].push_back(mask[id*per + c] & wanted[r][j + 1]);
+        }
+    const std::vector<std::vector<std::uint64_t>> got = comm_.exchange(answer);
+    L_.view = std::move(L_.ownLayout);
+    for (int r = 0; r < nRanks_; ++r)
+        for (std::size_t j = 0; j < got[r].size(); j += 1 + per)
+        {
+            const std::int64_t id = L_.view.findOrInsertKey(got[r][j]);
+            mask.resize(std::size_t(L_.view.size())*per, 0);
+            for (int c = 0; c < per; ++c) mask[id*per + c] |= got[r][j + 1 + c];
+        }
+    return std::move(L_);
+}
+
+template <int D>
+levelPlan<D> coefficientTiles(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                              const queryClusters<D>& clusters, int bucketTiles)
+{
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, params::exchangeMode::automatic).coefficientTiles(k);
 }
 
 template <int D>
@@ -672,8 +709,10 @@ levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, co
 
 template queryClusters<2> clusterQueryPoints<2>(const communicator&, const controlPoints<2>&, pointsView<2>);
 template queryClusters<3> clusterQueryPoints<3>(const communicator&, const controlPoints<3>&, pointsView<3>);
-template levelPlan<2> coefficientTiles<2>(int, const domain<2>&, const controlPoints<2>&);
-template levelPlan<3> coefficientTiles<3>(int, const domain<3>&, const controlPoints<3>&);
+template levelPlan<2> coefficientTiles<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
+                                          const queryClusters<2>&, int);
+template levelPlan<3> coefficientTiles<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
+                                          const queryClusters<3>&, int);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
                                    const queryClusters<2>&, int, params::exchangeMode);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,

@@ -179,14 +179,18 @@ levelPlan<D> unreadLevel(const levelPlan<D>& L)
     return u;
 }
 
-/// Level k's tiles (the view) and coefficientNodes alone, from this rank's
-/// control points, with level, scale and stats.level and h: what
-/// flatEvaluator::reads asks of a level, without the plan's omega values
-/// (its largest array while it is made), exchange and runs. On one rank
-/// reads() answers for it as for the full plan: a node's omega is > 0
-/// where a point's weight there is
+/// Level k's tiles (the view) and coefficientNodes alone, with level, scale
+/// and stats.level and h: what flatEvaluator::reads asks of a level,
+/// without the plan's omega values (its largest array while it is made),
+/// ghosts, exchange and runs. The own tiles' nodes where a control point's
+/// weight is > 0 (where the plan's omega, a sum of w^2, is), and on several
+/// ranks the other ranks' at the nodes of their tiles that this rank's
+/// query points' stencils touch, asked as the plan asks: at the nodes of
+/// its evaluation points' stencils the plan's view has the same
+/// coefficient nodes, and reads() the same answer. Collective
 template <int D>
-levelPlan<D> coefficientTiles(int k, const domain<D>& dom, const controlPoints<D>& ctrl);
+levelPlan<D> coefficientTiles(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
+                              const queryClusters<D>& clusters, int bucketTiles);
 
 /// Plans level k. Collective
 template <int D>

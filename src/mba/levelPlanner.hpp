@@ -86,6 +86,9 @@ public:
     {}
 
     levelPlan<D> run(int k);
+
+    /// The level's tiles and coefficient nodes alone (coefficientTiles)
+    levelPlan<D> coefficientTiles(int k);
 };
 
 } // namespace mba

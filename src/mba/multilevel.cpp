@@ -256,23 +256,18 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         if (k == int(s.levels.size()))
         {
             const double t1 = now();
-            // On one rank a level's control points' tiles alone say whether
-            // it is read: one that is not is never planned in full
+            // Whether a level is read follows from its control points'
+            // tiles alone: one that is not is never planned in full
             bool unread = false;
-            if (s.parameters.stopUnread && s.comm.size() == 1)
+            if (s.parameters.stopUnread)
             {
-                levelPlan<D> c = coefficientTiles<D>(k, s.dom, s.ctrl);
-                unread = !s.evaluator.reads(c);
+                levelPlan<D> c = coefficientTiles<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles);
+                unread = !(s.comm.max(s.evaluator.reads(c) ? 1.0 : 0.0) > 0);
                 if (unread) s.levels.push_back(unreadLevel(c));
             }
             if (!unread)
-            {
                 s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
                                                 s.parameters.exchange));
-                levelPlan<D>& L = s.levels.back();
-                if (s.parameters.stopUnread && !(s.comm.max(s.evaluator.reads(L) ? 1.0 : 0.0) > 0))
-                    L = unreadLevel(L);
-            }
             s.levels.back().stats.planSeconds = now() - t1;
         }
         if (!s.levels[k].read)

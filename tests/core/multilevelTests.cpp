@@ -465,7 +465,7 @@ TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan'
         INFO("masked " << masked << ", level " << k);
         const levelPlan<3> full = planLevel<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8,
                                                params::exchangeMode::automatic);
-        const levelPlan<3> alone = coefficientTiles<3>(k, dom, ctrl);
+        const levelPlan<3> alone = coefficientTiles<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8);
         REQUIRE(alone.coefficientNodes.size() == std::size_t(alone.view.size())*per);
         std::int64_t marked = 0, differ = 0;
         for (std::int64_t id = 0; id < full.view.size(); ++id)

@@ -3,9 +3,12 @@
 // suite for the serial and simulated implementations. (The exchanges'
 // own tests: exchangeTests.cpp.)
 #include "communicatorConformance.hpp"
+#include "levelPlan.hpp"
 #include "simulatedRanks.hpp"
 
 #include <catch2/catch.hpp>
+
+#include <numeric>
 
 using namespace mba;
 using namespace bsmTest;
@@ -88,6 +91,79 @@ TEST_CASE("a fit that stops before the unread levels: serial equals simulated ra
         double diff = 0;
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
         CHECK(diff <= 1e-12*maxAbs(w.v));
+    }
+}
+
+TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a rank's evaluation points read", "[parallel]")
+{
+    // (what a fit asks of a new level to find it unread, without planning
+    // it): per rank, at the nodes of positive weight in its evaluation
+    // points' stencils, coefficientTiles marks the nodes and components
+    // where the full plan's view has omega > 0, also where only another
+    // rank's control points reach them
+    const bool masked = GENERATE(true, false);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    const slidingWall<3> w(12);
+    const std::vector<point<3>> c = masked ? w.c : randomPoints<3>(300, 121);
+    const std::vector<std::uint8_t> mask = masked ? w.mask : std::vector<std::uint8_t>();
+    const std::vector<point<3>> e = randomPoints<3>(800, 122);
+    box<3> b = box<3>::empty();
+    for (const point<3>& x : c) b.add(x.data());
+    for (const point<3>& x : e) b.add(x.data());
+    const domain<3> dom = domain<3>::fromBox(b, 1, params().padding);
+    for (const int P : {2, 3, 5})
+    {
+        INFO("masked " << masked << ", partition " << name(how) << ", ranks " << P);
+        const auto rc = ranksOf<3>(c, P, how, 1), re = ranksOf<3>(e, P, how, 2);
+        std::vector<std::int64_t> marked(P, 0), differ(P, 0), remote(P, 0);
+        runSimulated(P, [&](const communicator& comm) {
+            const int me = comm.rank();
+            std::vector<point<3>> cl, el;
+            std::vector<std::uint8_t> ml;
+            for (std::size_t i = 0; i < c.size(); ++i)
+                if (rc[i] == me)
+                {
+                    cl.push_back(c[i]);
+                    if (masked) ml.insert(ml.end(), &mask[3*i], &mask[3*i] + 3);
+                }
+            for (std::size_t i = 0; i < e.size(); ++i) if (re[i] == me) el.push_back(e[i]);
+            controlPoints<3> ctrl(cl, 3, ml);
+            ctrl.classify(comm);
+            ctrl.arrange(dom);
+            const queryClusters<3> clusters = clusterQueryPoints<3>(comm, ctrl, el);
+            const int per = ctrl.omegaPerNode;
+            for (int k = 0; k < 9; ++k)
+            {
+                const levelPlan<3> full = planLevel<3>(k, comm, dom, ctrl, clusters, 8,
+                                                       params::exchangeMode::automatic);
+                const levelPlan<3> alone = coefficientTiles<3>(k, comm, dom, ctrl, clusters, 8);
+                // (this rank's own points' alone: the nodes only other ranks reach)
+                const levelPlan<3> own = coefficientTiles<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8);
+                for (const point<3>& x : el)
+                {
+                    const stencil<3> st = levelStencil<3>(dom.local0(x.data()), full.scale);
+                    forEachIndex<3>(st.tiles(), [&](const mba::index<3>& t) {
+                        const std::uint64_t nodes = st.nodesIn(t, true);
+                        const std::int64_t f = full.view.find(t), a = alone.view.find(t), o = own.view.find(t);
+                        for (int j = 0; j < per; ++j)
+                        {
+                            const std::uint64_t fm = f < 0 ? 0 : full.coefficientNodes[f*per + j] & nodes;
+                            const std::uint64_t am = a < 0 ? 0 : alone.coefficientNodes[a*per + j] & nodes;
+                            differ[me] += fm != am;
+                            marked[me] += fm != 0;
+                            remote[me] += (fm & ~(o < 0 ? 0 : own.coefficientNodes[o*per + j])) != 0;
+                        }
+                    });
+                }
+            }
+        });
+        for (int r = 0; r < P; ++r)
+        {
+            INFO("rank " << r);
+            CHECK(differ[r] == 0);
+            CHECK(marked[r] > 0);
+        }
+        CHECK(std::accumulate(remote.begin(), remote.end(), std::int64_t(0)) > 0);
     }
 }
 
