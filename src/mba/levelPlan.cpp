@@ -12,13 +12,20 @@
 
 namespace mba {
 
+/// The level's index, scale and node counts, and its own layout (empty)
 template <int D>
-levelPlan<D> levelPlanner<D>::run(int k)
+void levelPlanner<D>::startLevel(int k)
 {
     L_.level = k;
     L_.scale = std::ldexp(1.0, k);
     for (int d = 0; d < D; ++d) nodes_[d] = dom_.nodes(k, d);
     collectively(comm_, [&] { L_.ownLayout.init(nodes_, false); });
+}
+
+template <int D>
+levelPlan<D> levelPlanner<D>::run(int k)
+{
+    startLevel(k);
     ownTilesAndOmega();
     L_.tilesTo.assign(nRanks_, {});
     L_.tilesFrom.assign(nRanks_, {});
@@ -475,12 +482,9 @@ void levelPlanner<D>::fillStats()
 template <int D>
 levelPlan<D> levelPlanner<D>::coefficientTiles(int k)
 {
-    L_.level = k;
-    L_.scale = std::ldexp(1.0, k);
+    startLevel(k);
     L_.stats.level = k;
     L_.stats.h = dom_.h0/L_.scale;
-    for (int d = 0; d < D; ++d) nodes_[d] = dom_.nodes(k, d);
-    collectively(comm_, [&] { L_.ownLayout.init(nodes_, false); });
     ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L_.ownLayout, st); });
     nOwn_ = L_.ownLayout.size();
     const int per = omegaPerNode_;
@@ -496,31 +500,30 @@ levelPlan<D> levelPlanner<D>::coefficientTiles(int k)
                 if (per == 1 || ctrl_.mask[i*nc_ + c]) mask[id*per + c] |= std::uint64_t(1) << n;
         });
     });
-    if (nRanks_ == 1)
+    // on several ranks the tiles asked for (as the plan asks), answered with
+    // their masks at the nodes asked: key, then per omega value its nodes
+    std::vector<std::vector<std::uint64_t>> got;
+    if (nRanks_ > 1)
     {
-        L_.view = std::move(L_.ownLayout);
-        return std::move(L_);
+        const std::vector<std::vector<std::uint64_t>> wanted = comm_.exchange(tileRequests(bucketDirectory()));
+        std::vector<std::vector<std::uint64_t>> answer(nRanks_);
+        for (int r = 0; r < nRanks_; ++r)
+            for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
+            {
+                const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
+                if (id < 0) continue;
+                answer[r].push_back(wanted[r][j]);
+                for (int c = 0; c < per; ++c) answer[r].push_back(mask[id*per + c] & wanted[r][j + 1]);
+            }
+        got = comm_.exchange(answer);
     }
-    // the tiles asked for (as the plan asks), answered with their masks at
-    // the nodes asked: key, then per omega value its nodes
-    const std::vector<std::vector<std::uint64_t>> wanted = comm_.exchange(tileRequests(bucketDirectory()));
-    std::vector<std::vector<std::uint64_t>> answer(nRanks_);
-    for (int r = 0; r < nRanks_; ++r)
-        for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
-        {
-            const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
-            if (id < 0) continue;
-            answer[r].push_back(wanted[r][j]);
-            for (int c = 0; c < per; ++c) answer[r].push_back(mask[id*per + c] & wanted[r][j + 1]);
-        }
-    const std::vector<std::vector<std::uint64_t>> got = comm_.exchange(answer);
     L_.view = std::move(L_.ownLayout);
-    for (int r = 0; r < nRanks_; ++r)
-        for (std::size_t j = 0; j < got[r].size(); j += 1 + per)
+    for (const auto& g : got)
+        for (std::size_t j = 0; j < g.size(); j += 1 + per)
         {
-            const std::int64_t id = L_.view.findOrInsertKey(got[r][j]);
+            const std::int64_t id = L_.view.findOrInsertKey(g[j]);
             mask.resize(std::size_t(L_.view.size())*per, 0);
-            for (int c = 0; c < per; ++c) mask[id*per + c] |= got[r][j + 1 + c];
+            for (int c = 0; c < per; ++c) mask[id*per + c] |= g[j + 1 + c];
         }
     return std::move(L_);
 }

@@ -43,6 +43,7 @@ class levelPlanner
     /// per view node: 1 at the lone points' nodes (empty: no lone point)
     std::vector<std::uint8_t> loneNodes_;
 
+    void startLevel(int k);
     void ownTilesAndOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
