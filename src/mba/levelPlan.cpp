@@ -1,7 +1,7 @@
 // The planning of a level in the steps that levelPlanner::run() takes in
 // order (the query clusters and whom a rank asks for which tiles:
 // levelPlanRequests.cpp; the choice of the level's exchange:
-// levelPlanExchange.cpp), and a level's coefficient tiles alone.
+// levelPlanExchange.cpp).
 #include "levelPlanner.hpp"
 #include "collectively.hpp"
 #include "stencilKernels.hpp"
@@ -23,19 +23,29 @@ void levelPlanner<D>::startLevel(int k)
 }
 
 template <int D>
-levelPlan<D> levelPlanner<D>::run(int k)
+levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPlan<D>&)>& isRead)
 {
     startLevel(k);
-    ownTilesAndOmega();
+    ownTiles();
+    // on several ranks, what each rank asks of the others' tiles
+    std::vector<std::vector<std::uint64_t>> wanted;
+    if (nRanks_ > 1)
+    {
+        requests_ = tileRequests(bucketDirectory());
+        wanted = comm_.exchange(requests_);
+    }
+    if (isRead && !readByEvaluation(wanted, isRead))
+    {
+        L_.stats.level = k;
+        L_.stats.h = dom_.h0/L_.scale;
+        return unreadLevel(L_);
+    }
+    ownOmega();
     L_.tilesTo.assign(nRanks_, {});
     L_.tilesFrom.assign(nRanks_, {});
     keysFrom_.assign(nRanks_, {});
     omegaFrom_.assign(nRanks_, {});
-    if (nRanks_ > 1)
-    {
-        requests_ = tileRequests(bucketDirectory());
-        answerRequests(comm_.exchange(requests_));
-    }
+    if (nRanks_ > 1) answerRequests(wanted);
     assembleView();
     findControlTiles();
     testSeparation();
@@ -120,17 +130,85 @@ void levelPlanner<D>::findCoefficientRuns()
 }
 
 /// This rank's tiles, the tiles of each control point's stencil (found once:
-/// for omega, the ghosts and the fits) and partial omega
+/// for omega, the ghosts and the fits) and the nodes where its partial
+/// omega is > 0 (ownMask_)
 template <int D>
-void levelPlanner<D>::ownTilesAndOmega()
+void levelPlanner<D>::ownTiles()
 {
     ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L_.ownLayout, st); });
     nOwn_ = L_.ownLayout.size();
     ownIds_.resize(ctrl_.order.size());
-    ownOmega_.assign(nOwn_*npt*omegaPerNode_, 0.0);
+    const int per = omegaPerNode_;
+    ownMask_.assign(std::size_t(nOwn_)*per, 0);
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
         findTiles(L_.ownLayout, st, ownIds_[pos]);
+        detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
+            if (!(w*w > 0)) return;
+            for (int c = 0; c < per; ++c)
+                if (per == 1 || ctrl_.mask[i*nc_ + c]) ownMask_[id*per + c] |= std::uint64_t(1) << n;
+        });
+    });
+}
+
+/// Whether an evaluation point of some rank reads the level (isRead) by its
+/// coefficient tiles alone (planLevel): the own tiles with ownMask_ and, on
+/// several ranks, the tiles this rank asked for with their owners' masks at
+/// the nodes it asked (wanted: what the others asked of this rank).
+/// Collective
+template <int D>
+bool levelPlanner<D>::readByEvaluation(const std::vector<std::vector<std::uint64_t>>& wanted,
+                                       const std::function<bool(const levelPlan<D>&)>& isRead)
+{
+    const int per = omegaPerNode_;
+    levelPlan<D> c;
+    c.level = L_.level;
+    c.scale = L_.scale;
+    if (nRanks_ == 1)
+    {
+        // (lent, and given back below)
+        c.view = std::move(L_.ownLayout);
+        c.coefficientNodes = std::move(ownMask_);
+    }
+    else
+    {
+        c.view = L_.ownLayout;
+        c.coefficientNodes = ownMask_;
+        // each tile asked for that this rank holds: its key, then per omega
+        // value its nodes among those asked
+        std::vector<std::vector<std::uint64_t>> answer(nRanks_);
+        for (int r = 0; r < nRanks_; ++r)
+            for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
+            {
+                const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
+                if (id < 0) continue;
+                answer[r].push_back(wanted[r][j]);
+                for (int m = 0; m < per; ++m) answer[r].push_back(ownMask_[id*per + m] & wanted[r][j + 1]);
+            }
+        for (const auto& g : comm_.exchange(answer))
+            for (std::size_t j = 0; j < g.size(); j += 1 + per)
+            {
+                const std::int64_t id = c.view.findOrInsertKey(g[j]);
+                c.coefficientNodes.resize(std::size_t(c.view.size())*per, 0);
+                for (int m = 0; m < per; ++m) c.coefficientNodes[id*per + m] |= g[j + 1 + m];
+            }
+    }
+    const bool read = comm_.max(isRead(c) ? 1.0 : 0.0) > 0;
+    if (nRanks_ == 1)
+    {
+        L_.ownLayout = std::move(c.view);
+        ownMask_ = std::move(c.coefficientNodes);
+    }
+    return read;
+}
+
+/// This rank's partial omega on its own tiles
+template <int D>
+void levelPlanner<D>::ownOmega()
+{
+    ownOmega_.assign(nOwn_*npt*omegaPerNode_, 0.0);
+    std::size_t pos = 0;
+    ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
         detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
             double* o = &ownOmega_[(id*npt + n)*omegaPerNode_];
             if (omegaPerNode_ == 1) o[0] += w*w;
@@ -475,80 +553,19 @@ void levelPlanner<D>::fillStats()
     }
 }
 
-/// Own tiles and their coefficient nodes from the control points' weights;
-/// on several ranks also those of the other ranks' tiles that this rank's
-/// query points' stencils touch (the plan's tile requests), at the nodes
-/// they read
-template <int D>
-levelPlan<D> levelPlanner<D>::coefficientTiles(int k)
-{
-    startLevel(k);
-    L_.stats.level = k;
-    L_.stats.h = dom_.h0/L_.scale;
-    ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) { insertStencil(L_.ownLayout, st); });
-    nOwn_ = L_.ownLayout.size();
-    const int per = omegaPerNode_;
-    std::vector<std::uint64_t>& mask = L_.coefficientNodes;
-    mask.assign(std::size_t(nOwn_)*per, 0);
-    stencilTiles<D> tid;
-    ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
-        findTiles(L_.ownLayout, st, tid);
-        detail::visitStencil(tid, st, [&](std::int64_t id, int n, double w) {
-            // (where the plan's omega, a sum of w^2, is > 0)
-            if (!(w*w > 0)) return;
-            for (int c = 0; c < per; ++c)
-                if (per == 1 || ctrl_.mask[i*nc_ + c]) mask[id*per + c] |= std::uint64_t(1) << n;
-        });
-    });
-    // on several ranks the tiles asked for (as the plan asks), answered with
-    // their masks at the nodes asked: key, then per omega value its nodes
-    std::vector<std::vector<std::uint64_t>> got;
-    if (nRanks_ > 1)
-    {
-        const std::vector<std::vector<std::uint64_t>> wanted = comm_.exchange(tileRequests(bucketDirectory()));
-        std::vector<std::vector<std::uint64_t>> answer(nRanks_);
-        for (int r = 0; r < nRanks_; ++r)
-            for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
-            {
-                const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
-                if (id < 0) continue;
-                answer[r].push_back(wanted[r][j]);
-                for (int c = 0; c < per; ++c) answer[r].push_back(mask[id*per + c] & wanted[r][j + 1]);
-            }
-        got = comm_.exchange(answer);
-    }
-    L_.view = std::move(L_.ownLayout);
-    for (const auto& g : got)
-        for (std::size_t j = 0; j < g.size(); j += 1 + per)
-        {
-            const std::int64_t id = L_.view.findOrInsertKey(g[j]);
-            mask.resize(std::size_t(L_.view.size())*per, 0);
-            for (int c = 0; c < per; ++c) mask[id*per + c] |= g[j + 1 + c];
-        }
-    return std::move(L_);
-}
-
-template <int D>
-levelPlan<D> coefficientTiles(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                              const queryClusters<D>& clusters, int bucketTiles)
-{
-    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, params::exchangeMode::automatic).coefficientTiles(k);
-}
-
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode)
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
+                       const std::function<bool(const levelPlan<D>&)>& isRead)
 {
-    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode).run(k);
+    return levelPlanner<D>(comm, dom, ctrl, clusters, bucketTiles, mode).run(k, isRead);
 }
 
-template levelPlan<2> coefficientTiles<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
-                                          const queryClusters<2>&, int);
-template levelPlan<3> coefficientTiles<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
-                                          const queryClusters<3>&, int);
 template levelPlan<2> planLevel<2>(int, const communicator&, const domain<2>&, const controlPoints<2>&,
-                                   const queryClusters<2>&, int, params::exchangeMode);
+                                   const queryClusters<2>&, int, params::exchangeMode,
+                                   const std::function<bool(const levelPlan<2>&)>&);
 template levelPlan<3> planLevel<3>(int, const communicator&, const domain<3>&, const controlPoints<3>&,
-                                   const queryClusters<3>&, int, params::exchangeMode);
+                                   const queryClusters<3>&, int, params::exchangeMode,
+                                   const std::function<bool(const levelPlan<3>&)>&);
 
 } // namespace mba

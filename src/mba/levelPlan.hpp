@@ -29,6 +29,7 @@
 #include "chunkExchange.hpp"
 
 #include <deque>
+#include <functional>
 #include <utility>
 
 namespace mba {
@@ -179,23 +180,21 @@ levelPlan<D> unreadLevel(const levelPlan<D>& L)
     return u;
 }
 
-/// Level k's tiles (the view) and coefficientNodes alone, with level, scale
-/// and stats.level and h: what flatEvaluator::reads asks of a level,
-/// without the plan's omega values (its largest array while it is made),
-/// ghosts, exchange and runs. The own tiles' nodes where a control point's
-/// weight is > 0 (where the plan's omega, a sum of w^2, is), and on several
-/// ranks the other ranks' at the nodes of their tiles that this rank's
-/// query points' stencils touch, asked as the plan asks: at the nodes of
-/// its evaluation points' stencils the plan's view has the same
-/// coefficient nodes, and reads() the same answer. Collective
-template <int D>
-levelPlan<D> coefficientTiles(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                              const queryClusters<D>& clusters, int bucketTiles);
-
-/// Plans level k. Collective
+/// Plans level k. Collective. With isRead, it first asks isRead whether
+/// this rank's evaluation points read the level, given the level's tiles
+/// (view), level, scale and coefficientNodes alone: the own tiles' nodes
+/// where a control point's weight is > 0 (where the plan's omega, a sum of
+/// w^2, is), and on several ranks the other ranks' at the nodes of their
+/// tiles that this rank's query points' stencils touch, asked as the plan
+/// asks them. At the nodes of this rank's evaluation points' stencils the
+/// full plan's view has the same coefficient nodes (flatEvaluator::reads
+/// gives the same answer), without its omega values (a plan's largest
+/// array while it is made), ghosts, exchange and runs. When no rank's
+/// isRead is true, the level is returned unplanned (unreadLevel)
 template <int D>
 levelPlan<D> planLevel(int k, const communicator& comm, const domain<D>& dom, const controlPoints<D>& ctrl,
-                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode);
+                       const queryClusters<D>& clusters, int bucketTiles, params::exchangeMode mode,
+                       const std::function<bool(const levelPlan<D>&)>& isRead = nullptr);
 
 } // namespace mba
 #endif

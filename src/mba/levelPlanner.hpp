@@ -8,6 +8,7 @@
 #include "levelPlan.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace mba {
@@ -31,6 +32,10 @@ class levelPlanner
     index<D> nodes_;                    ///< the level's nodes per direction
     std::int64_t nOwn_ = 0;             ///< own tiles
     std::vector<stencilTiles<D>> ownIds_; ///< the own points' stencil tiles in the own layout, in order
+    /// per own tile and omega value: the nodes where this rank's partial
+    /// omega is > 0 (bit n: node n), where a weight w of a point it holds
+    /// has w^2 > 0
+    std::vector<std::uint64_t> ownMask_;
     hugeVector<double> ownOmega_;       ///< this rank's partial omega on its own tiles (may become the view's)
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
@@ -44,7 +49,10 @@ class levelPlanner
     std::vector<std::uint8_t> loneNodes_;
 
     void startLevel(int k);
-    void ownTilesAndOmega();
+    void ownTiles();
+    bool readByEvaluation(const std::vector<std::vector<std::uint64_t>>& wanted,
+                          const std::function<bool(const levelPlan<D>&)>& isRead);
+    void ownOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
     std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
@@ -63,9 +71,7 @@ class levelPlanner
     std::uint64_t ownNodes(std::int64_t o) const
     {
         std::uint64_t nodes = 0;
-        for (int n = 0; n < npt; ++n)
-            for (int c = 0; c < omegaPerNode_; ++c)
-                if (ownOmega_[(o*npt + n)*omegaPerNode_ + c] > 0) nodes |= std::uint64_t(1) << n;
+        for (int c = 0; c < omegaPerNode_; ++c) nodes |= ownMask_[o*omegaPerNode_ + c];
         return nodes;
     }
     void findCoefficientNodes();
@@ -86,10 +92,8 @@ public:
         nRanks_(comm.size()), me_(comm.rank()), nc_(ctrl.nComponents), omegaPerNode_(ctrl.omegaPerNode)
     {}
 
-    levelPlan<D> run(int k);
-
-    /// The level's tiles and coefficient nodes alone (coefficientTiles)
-    levelPlan<D> coefficientTiles(int k);
+    /// planLevel
+    levelPlan<D> run(int k, const std::function<bool(const levelPlan<D>&)>& isRead);
 };
 
 } // namespace mba

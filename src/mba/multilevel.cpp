@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
 namespace mba {
 
@@ -258,16 +259,10 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
             const double t1 = now();
             // Whether a level is read follows from its control points'
             // tiles alone: one that is not is never planned in full
-            bool unread = false;
-            if (s.parameters.stopUnread)
-            {
-                levelPlan<D> c = coefficientTiles<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles);
-                unread = !(s.comm.max(s.evaluator.reads(c) ? 1.0 : 0.0) > 0);
-                if (unread) s.levels.push_back(unreadLevel(c));
-            }
-            if (!unread)
-                s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
-                                                s.parameters.exchange));
+            std::function<bool(const levelPlan<D>&)> isRead;
+            if (s.parameters.stopUnread) isRead = [&](const levelPlan<D>& c) { return s.evaluator.reads(c); };
+            s.levels.push_back(planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles,
+                                            s.parameters.exchange, isRead));
             s.levels.back().stats.planSeconds = now() - t1;
         }
         if (!s.levels[k].read)

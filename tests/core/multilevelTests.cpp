@@ -446,8 +446,8 @@ TEST_CASE("a fit can stop before the levels that no evaluation point reads", "[c
 
 TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan's omega is > 0", "[multilevel]")
 {
-    // (what a fit on one rank asks of a new level to find it unread,
-    // without planning it): a sliding wall (a mask, one omega a component)
+    // (what the plan of a new level asks the fit on one rank, to find it
+    // unread before planning it in full): a sliding wall (a mask, one omega a component)
     // and scattered points (one omega a node), levels 0 to 9
     const bool masked = GENERATE(true, false);
     const slidingWall<3> w(12);
@@ -463,9 +463,9 @@ TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan'
     for (int k = 0; k < 10; ++k)
     {
         INFO("masked " << masked << ", level " << k);
+        levelPlan<3> alone;
         const levelPlan<3> full = planLevel<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8,
-                                               params::exchangeMode::automatic);
-        const levelPlan<3> alone = coefficientTiles<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8);
+                                               params::exchangeMode::automatic, coefficientTilesOf(alone));
         REQUIRE(alone.coefficientNodes.size() == std::size_t(alone.view.size())*per);
         std::int64_t marked = 0, differ = 0;
         for (std::int64_t id = 0; id < full.view.size(); ++id)

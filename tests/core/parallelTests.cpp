@@ -96,9 +96,10 @@ TEST_CASE("a fit that stops before the unread levels: serial equals simulated ra
 
 TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a rank's evaluation points read", "[parallel]")
 {
-    // (what a fit asks of a new level to find it unread, without planning
-    // it): per rank, at the nodes of positive weight in its evaluation
-    // points' stencils, coefficientTiles marks the nodes and components
+    // (what the plan of a new level asks the fit, to find it unread before
+    // planning it in full): per rank, at the nodes of positive weight in its
+    // evaluation points' stencils, the coefficient tiles mark the nodes and
+    // components
     // where the full plan's view has omega > 0, also where only another
     // rank's control points reach them
     const bool masked = GENERATE(true, false);
@@ -134,11 +135,12 @@ TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a ran
             const int per = ctrl.omegaPerNode;
             for (int k = 0; k < 9; ++k)
             {
+                levelPlan<3> alone, own;
                 const levelPlan<3> full = planLevel<3>(k, comm, dom, ctrl, clusters, 8,
-                                                       params::exchangeMode::automatic);
-                const levelPlan<3> alone = coefficientTiles<3>(k, comm, dom, ctrl, clusters, 8);
+                                                       params::exchangeMode::automatic, coefficientTilesOf(alone));
                 // (this rank's own points' alone: the nodes only other ranks reach)
-                const levelPlan<3> own = coefficientTiles<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8);
+                planLevel<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8, params::exchangeMode::automatic,
+                             coefficientTilesOf(own));
                 for (const point<3>& x : el)
                 {
                     const stencil<3> st = levelStencil<3>(dom.local0(x.data()), full.scale);

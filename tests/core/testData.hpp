@@ -3,9 +3,11 @@
 #define BSM_TEST_DATA_HPP
 
 #include "lattice.hpp"
+#include "levelPlan.hpp"
 #include "multilevel.hpp"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <random>
 #include <vector>
@@ -20,6 +22,21 @@ struct vectorWidth
     explicit vectorWidth(bool wide) : was(mba::useWideVectors(wide)) {}
     ~vectorWidth() { mba::useWideVectors(was); }
 };
+
+/// A read test for planLevel that keeps what it is given (a level's
+/// coefficient tiles alone: view, level, scale, coefficientNodes) in c and
+/// answers read, so that the plan goes on
+template <int D>
+std::function<bool(const mba::levelPlan<D>&)> coefficientTilesOf(mba::levelPlan<D>& c)
+{
+    return [&c](const mba::levelPlan<D>& L) {
+        c.level = L.level;
+        c.scale = L.scale;
+        c.view = L.view;
+        c.coefficientNodes = L.coefficientNodes;
+        return true;
+    };
+}
 
 template <int D>
 std::vector<mba::point<D>> randomPoints(std::size_t n, unsigned seed, double lo = 0, double hi = 1)
