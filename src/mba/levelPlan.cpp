@@ -71,16 +71,29 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
     return std::move(L_);
 }
 
-/// levelPlan::coefficientNodes from 1/omega
+/// levelPlan::coefficientNodes: the nodes where omega, the ranks' partial
+/// sums (each >= 0) added, is > 0: where this rank's is (ownMask_) or a
+/// partial omega received from another rank is
 template <int D>
 void levelPlanner<D>::findCoefficientNodes()
 {
     const int per = omegaPerNode_;
-    L_.coefficientNodes.assign(std::size_t(L_.view.size())*per, 0);
-    for (std::int64_t id = 0; id < L_.view.size(); ++id)
-        for (int n = 0; n < npt; ++n)
-            for (int j = 0; j < per; ++j)
-                if (L_.invOmega[(id*npt + n)*per + j] > 0) L_.coefficientNodes[id*per + j] |= std::uint64_t(1) << n;
+    std::vector<std::uint64_t>& cn = L_.coefficientNodes;
+    if (L_.ownIsView) cn = ownMask_;
+    else
+    {
+        cn.assign(std::size_t(L_.view.size())*per, 0);
+        for (std::int64_t o = 0; o < nOwn_; ++o)
+            for (int j = 0; j < per; ++j) cn[ownToView_[o]*per + j] |= ownMask_[o*per + j];
+    }
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        const std::vector<double>& og = omegaFrom_[r];
+        for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
+            for (int n = 0; n < npt; ++n)
+                for (int j = 0; j < per; ++j)
+                    if (og[(t*npt + n)*per + j] > 0) cn[L_.tilesFrom[r][t]*per + j] |= std::uint64_t(1) << n;
+    }
 }
 
 /// What the fits read of 1/omega after the plan: on plain levels runScales,
@@ -142,12 +155,15 @@ void levelPlanner<D>::ownTiles()
     ownMask_.assign(std::size_t(nOwn_)*per, 0);
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
-        findTiles(L_.ownLayout, st, ownIds_[pos]);
-        detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
-            if (!(w*w > 0)) return;
+        stencilTiles<D>& tid = ownIds_[pos++];
+        findTiles(L_.ownLayout, st, tid);
+        const auto nodes = detail::positiveNodes(st);
+        for (int t = 0; t < (1 << D); ++t)
+        {
+            if (tid[t] < 0) continue;
             for (int c = 0; c < per; ++c)
-                if (per == 1 || ctrl_.mask[i*nc_ + c]) ownMask_[id*per + c] |= std::uint64_t(1) << n;
-        });
+                if (per == 1 || ctrl_.mask[i*nc_ + c]) ownMask_[std::size_t(tid[t])*per + c] |= nodes[t];
+        }
     });
 }
 
@@ -206,13 +222,22 @@ bool levelPlanner<D>::readByEvaluation(const std::vector<std::vector<std::uint64
 template <int D>
 void levelPlanner<D>::ownOmega()
 {
-    ownOmega_.assign(nOwn_*npt*omegaPerNode_, 0.0);
+    const int per = omegaPerNode_;
+    ownOmega_.assign(nOwn_*npt*per, 0.0);
+    double* omega = ownOmega_.data();
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
+        if (per == 1)
+        {
+            detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
+                omega[id*npt + n] += w*w;
+            });
+            return;
+        }
+        const std::uint8_t* m = &ctrl_.mask[i*nc_];
         detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
-            double* o = &ownOmega_[(id*npt + n)*omegaPerNode_];
-            if (omegaPerNode_ == 1) o[0] += w*w;
-            else for (int c = 0; c < omegaPerNode_; ++c) if (ctrl_.mask[i*nc_ + c]) o[c] += w*w;
+            double* o = omega + (id*npt + n)*per;
+            for (int c = 0; c < per; ++c) if (m[c]) o[c] += w*w;
         });
     });
 }

@@ -130,6 +130,26 @@ void visitStencil(const stencilTiles<D>& tid, const stencil<D>& st, F&& f)
     });
 }
 
+/// Per entry t of a stencil's tiles (stencilTiles), the nodes there where the
+/// weight w, formed as visitStencil forms it, has w*w > 0 (bit n: node n)
+template <int D>
+inline std::array<std::uint64_t, (1 << D)> positiveNodes(const stencil<D>& st)
+{
+    std::array<std::uint64_t, (1 << D)> m{};
+    const int oz = int(st.base[D - 1] & 3);
+    const double* wz = st.w[D - 1];
+    forRows(st, [&](int t, int n, double w) {
+        // the row's 4 nodes (bit c: node c along the last direction), from
+        // node oz of tile t's row on, then from node 0 of tile t + 1's
+        const double w0 = w*wz[0], w1 = w*wz[1], w2 = w*wz[2], w3 = w*wz[3];
+        const std::uint64_t p = std::uint64_t(w0*w0 > 0) | std::uint64_t(w1*w1 > 0) << 1
+            | std::uint64_t(w2*w2 > 0) << 2 | std::uint64_t(w3*w3 > 0) << 3;
+        m[t] |= ((p << oz) & 15) << n;
+        if (oz > 0) m[t + 1] |= (p >> (4 - oz)) << n;
+    });
+    return m;
+}
+
 /// Row n (a node of the tile where a tile row starts) of tile id, NC values
 /// a node; absent where id < 0: then the given stand-in (zeros to read, a
 /// sink to write)
