@@ -444,11 +444,13 @@ TEST_CASE("a fit can stop before the levels that no evaluation point reads", "[c
     stopsBeforeUnreadLevels<3>();
 }
 
-TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan's omega is > 0", "[multilevel]")
+TEST_CASE("a level's coefficient tiles alone and its full plan mark the nodes where omega is > 0", "[multilevel]")
 {
-    // (what the plan of a new level asks the fit on one rank, to find it
-    // unread before planning it in full): a sliding wall (a mask, one omega a component)
-    // and scattered points (one omega a node), levels 0 to 9
+    // (the coefficient tiles alone: what the plan of a new level asks the
+    // fit on one rank, to find it unread before planning it in full); omega
+    // is > 0 where some control point's weight w has w^2 > 0, found node by
+    // node: a sliding wall (a mask, one omega a component) and scattered
+    // points (one omega a node), levels 0 to 9
     const bool masked = GENERATE(true, false);
     const slidingWall<3> w(12);
     const std::vector<point<3>> c = masked ? w.c : randomPoints<3>(300, 121);
@@ -466,21 +468,13 @@ TEST_CASE("a level's coefficient tiles alone mark the nodes where its full plan'
         levelPlan<3> alone;
         const levelPlan<3> full = planLevel<3>(k, serial(), dom, ctrl, queryClusters<3>(), 8,
                                                params::exchangeMode::automatic, coefficientTilesOf(alone));
+        REQUIRE(full.coefficientNodes.size() == std::size_t(full.view.size())*per);
         REQUIRE(alone.coefficientNodes.size() == std::size_t(alone.view.size())*per);
-        std::int64_t marked = 0, differ = 0;
-        for (std::int64_t id = 0; id < full.view.size(); ++id)
-        {
-            const std::int64_t a = alone.view.findKey(full.view.keyOf(id));
-            for (int j = 0; j < per; ++j)
-            {
-                const std::uint64_t f = full.coefficientNodes[id*per + j];
-                const std::uint64_t m = a < 0 ? 0 : alone.coefficientNodes[a*per + j];
-                differ += f != m;
-                marked += f != 0;
-            }
-        }
-        CHECK(marked > 0);
-        CHECK(differ == 0);
+        // node by node, against every control point's weights
+        const tileNodeMasks<3> oracle = positiveWeightNodes<3>(ctrl, full.scale);
+        CHECK(!oracle.empty());
+        CHECK((markedNodes<3>(full, per) == oracle));
+        CHECK((markedNodes<3>(alone, per) == oracle));
         // (and no tile of its own that the plan lacks)
         for (std::int64_t a = 0; a < alone.view.size(); ++a) CHECK(full.view.findKey(alone.view.keyOf(a)) >= 0);
     }

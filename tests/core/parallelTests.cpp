@@ -94,14 +94,14 @@ TEST_CASE("a fit that stops before the unread levels: serial equals simulated ra
     }
 }
 
-TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a rank's evaluation points read", "[parallel]")
+TEST_CASE("a level's coefficient tiles alone and its full plan, at the nodes a rank's evaluation points read", "[parallel]")
 {
     // (what the plan of a new level asks the fit, to find it unread before
     // planning it in full): per rank, at the nodes of positive weight in its
-    // evaluation points' stencils, the coefficient tiles mark the nodes and
-    // components
-    // where the full plan's view has omega > 0, also where only another
-    // rank's control points reach them
+    // evaluation points' stencils, the coefficient tiles and the full plan
+    // mark the nodes and components where some control point of any rank
+    // has a weight w with w^2 > 0 (found node by node from all of them),
+    // also where only another rank's control points reach them
     const bool masked = GENERATE(true, false);
     const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
     const slidingWall<3> w(12);
@@ -112,6 +112,12 @@ TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a ran
     for (const point<3>& x : c) b.add(x.data());
     for (const point<3>& x : e) b.add(x.data());
     const domain<3> dom = domain<3>::fromBox(b, 1, params().padding);
+    // (the oracle: every control point, on one rank)
+    controlPoints<3> all(c, 3, mask);
+    all.classify(serial());
+    all.arrange(dom);
+    std::vector<tileNodeMasks<3>> oracle;
+    for (int k = 0; k < 9; ++k) oracle.push_back(positiveWeightNodes<3>(all, std::ldexp(1.0, k)));
     for (const int P : {2, 3, 5})
     {
         INFO("masked " << masked << ", partition " << name(how) << ", ranks " << P);
@@ -151,7 +157,8 @@ TEST_CASE("a level's coefficient tiles alone: the full plan's at the nodes a ran
                         {
                             const std::uint64_t fm = f < 0 ? 0 : full.coefficientNodes[f*per + j] & nodes;
                             const std::uint64_t am = a < 0 ? 0 : alone.coefficientNodes[a*per + j] & nodes;
-                            differ[me] += fm != am;
+                            const std::uint64_t om = nodesAt<3>(oracle[k], t, j) & nodes;
+                            differ[me] += (fm != om) + (am != om);
                             marked[me] += fm != 0;
                             remote[me] += (fm & ~(o < 0 ? 0 : own.coefficientNodes[o*per + j])) != 0;
                         }

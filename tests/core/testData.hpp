@@ -6,6 +6,8 @@
 #include "levelPlan.hpp"
 #include "multilevel.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -22,6 +24,78 @@ struct vectorWidth
     explicit vectorWidth(bool wide) : was(mba::useWideVectors(wide)) {}
     ~vectorWidth() { mba::useWideVectors(was); }
 };
+
+/// Per tile and omega value (the component j where a node holds one omega
+/// per component, else 0): key {tile coordinates..., j}, the nodes of the
+/// tile (bit n: node n, the last direction fastest)
+template <int D>
+using tileNodeMasks = std::map<std::array<std::int64_t, D + 1>, std::uint64_t>;
+
+/// The nodes of the level of scale s where a control point of ctrl has a
+/// weight w with w*w > 0, its weights multiplied in the order of the
+/// directions as the plan multiplies them, found node by node (the oracle of
+/// the plan's coefficient nodes: omega, a sum of w^2, is > 0 there)
+template <int D>
+tileNodeMasks<D> positiveWeightNodes(const mba::controlPoints<D>& ctrl, double s)
+{
+    tileNodeMasks<D> nodes;
+    const int per = ctrl.omegaPerNode;
+    ctrl.forEachStencil(s, [&](std::size_t i, const mba::stencil<D>& st) {
+        for (int a = 0; a < (1 << 2*D); ++a)
+        {
+            double w = 1;
+            std::array<std::int64_t, D + 1> key;
+            int n = 0;
+            for (int d = 0; d < D; ++d)
+            {
+                const int at = (a >> 2*(D - 1 - d)) & 3;
+                w = d == 0 ? st.w[0][at] : w*st.w[d][at];
+                const std::int64_t x = st.base[d] + at;
+                key[d] = x/mba::tileEdge;
+                n = n*mba::tileEdge + int(x % mba::tileEdge);
+            }
+            if (!(w*w > 0)) continue;
+            for (int j = 0; j < per; ++j)
+            {
+                if (per > 1 && !ctrl.mask[i*ctrl.nComponents + j]) continue;
+                key[D] = j;
+                nodes[key] |= std::uint64_t(1) << n;
+            }
+        }
+    });
+    return nodes;
+}
+
+/// What a plan's coefficientNodes mark (per omega value of per), as
+/// positiveWeightNodes gives it
+template <int D>
+tileNodeMasks<D> markedNodes(const mba::levelPlan<D>& L, int per)
+{
+    tileNodeMasks<D> nodes;
+    for (std::int64_t id = 0; id < L.view.size(); ++id)
+    {
+        const mba::index<D> t = L.view.coord(L.view.keyOf(id));
+        std::array<std::int64_t, D + 1> key;
+        std::copy(t.begin(), t.end(), key.begin());
+        for (int j = 0; j < per; ++j)
+        {
+            key[D] = j;
+            if (L.coefficientNodes[id*per + j]) nodes[key] = L.coefficientNodes[id*per + j];
+        }
+    }
+    return nodes;
+}
+
+/// The nodes of tile t, omega value j, in masks (0 where none)
+template <int D>
+std::uint64_t nodesAt(const tileNodeMasks<D>& masks, const mba::index<D>& t, int j)
+{
+    std::array<std::int64_t, D + 1> key;
+    std::copy(t.begin(), t.end(), key.begin());
+    key[D] = j;
+    const auto it = masks.find(key);
+    return it == masks.end() ? 0 : it->second;
+}
 
 /// A read test for planLevel that keeps what it is given (a level's
 /// coefficient tiles alone: view, level, scale, coefficientNodes) in c and
