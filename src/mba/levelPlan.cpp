@@ -27,25 +27,24 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
 {
     startLevel(k);
     ownTiles();
-    // on several ranks, what each rank asks of the others' tiles
-    std::vector<std::vector<std::uint64_t>> wanted;
+    L_.tilesTo.assign(nRanks_, {});
+    asked_.assign(nRanks_, {});
     if (nRanks_ > 1)
     {
         requests_ = tileRequests(bucketDirectory());
-        wanted = comm_.exchange(requests_);
+        findAskedTiles(comm_.exchange(requests_));
     }
-    if (isRead && !readByEvaluation(wanted, isRead))
+    if (isRead && !readByEvaluation(isRead))
     {
         L_.stats.level = k;
         L_.stats.h = dom_.h0/L_.scale;
         return unreadLevel(L_);
     }
     ownOmega();
-    L_.tilesTo.assign(nRanks_, {});
     L_.tilesFrom.assign(nRanks_, {});
     keysFrom_.assign(nRanks_, {});
     omegaFrom_.assign(nRanks_, {});
-    if (nRanks_ > 1) answerRequests(wanted);
+    if (nRanks_ > 1) answerRequests();
     assembleView();
     findControlTiles();
     testSeparation();
@@ -167,14 +166,28 @@ void levelPlanner<D>::ownTiles()
     });
 }
 
+/// The own tiles other ranks asked for (wanted: per rank its keys, each
+/// followed by the nodes it reads there): their ids (tilesTo, own ids until
+/// the view is assembled) and the nodes asked (asked_)
+template <int D>
+void levelPlanner<D>::findAskedTiles(const std::vector<std::vector<std::uint64_t>>& wanted)
+{
+    for (int r = 0; r < nRanks_; ++r)
+        for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
+        {
+            const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
+            if (id < 0) continue;
+            L_.tilesTo[r].push_back(id);
+            asked_[r].push_back(wanted[r][j + 1]);
+        }
+}
+
 /// Whether an evaluation point of some rank reads the level (isRead) by its
 /// coefficient tiles alone (planLevel): the own tiles with ownMask_ and, on
 /// several ranks, the tiles this rank asked for with their owners' masks at
-/// the nodes it asked (wanted: what the others asked of this rank).
-/// Collective
+/// the nodes it asked (answered from tilesTo and asked_). Collective
 template <int D>
-bool levelPlanner<D>::readByEvaluation(const std::vector<std::vector<std::uint64_t>>& wanted,
-                                       const std::function<bool(const levelPlan<D>&)>& isRead)
+bool levelPlanner<D>::readByEvaluation(const std::function<bool(const levelPlan<D>&)>& isRead)
 {
     const int per = omegaPerNode_;
     levelPlan<D> c;
@@ -194,12 +207,11 @@ bool levelPlanner<D>::readByEvaluation(const std::vector<std::vector<std::uint64
         // value its nodes among those asked
         std::vector<std::vector<std::uint64_t>> answer(nRanks_);
         for (int r = 0; r < nRanks_; ++r)
-            for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
+            for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
             {
-                const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
-                if (id < 0) continue;
-                answer[r].push_back(wanted[r][j]);
-                for (int m = 0; m < per; ++m) answer[r].push_back(ownMask_[id*per + m] & wanted[r][j + 1]);
+                const std::int64_t id = L_.tilesTo[r][j];
+                answer[r].push_back(L_.ownLayout.keyOf(id));
+                for (int m = 0; m < per; ++m) answer[r].push_back(ownMask_[id*per + m] & asked_[r][j]);
             }
         for (const auto& g : comm_.exchange(answer))
             for (std::size_t j = 0; j < g.size(); j += 1 + per)
@@ -242,29 +254,19 @@ void levelPlanner<D>::ownOmega()
     });
 }
 
-/// The own tiles other ranks asked for (wanted: per rank its keys, each
-/// followed by the nodes it reads there): their ids (tilesTo, own ids for
-/// now), the nodes asked (asked_) and those whose partial sums tiles would
-/// carry (nodesTo); then how the sums go (chooseGhosts), and to each asking
-/// rank the answer: ghosts or tiles, the keys of the tiles this rank holds
-/// with their nodesTo, their partial omega, and the ghosts
+/// Of the own tiles other ranks asked for (tilesTo, asked_ from
+/// findAskedTiles), the nodes whose partial sums tiles would carry
+/// (nodesTo); then how the sums go (chooseGhosts), and to each asking rank
+/// the answer: ghosts or tiles, the keys of the tiles this rank holds with
+/// their nodesTo, their partial omega, and the ghosts
 template <int D>
-void levelPlanner<D>::answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted)
+void levelPlanner<D>::answerRequests()
 {
-    asked_.assign(nRanks_, {});
     L_.nodesTo.assign(nRanks_, {});
     const int blk = npt*omegaPerNode_;
     for (int r = 0; r < nRanks_; ++r)
-    {
-        for (std::size_t j = 0; j + 1 < wanted[r].size(); j += 2)
-        {
-            const std::int64_t id = L_.ownLayout.findKey(wanted[r][j]);
-            if (id < 0) continue;
-            L_.tilesTo[r].push_back(id);
-            asked_[r].push_back(wanted[r][j + 1]);
-            L_.nodesTo[r].push_back(wanted[r][j + 1] & ownNodes(id));
-        }
-    }
+        for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
+            L_.nodesTo[r].push_back(asked_[r][j] & ownNodes(L_.tilesTo[r][j]));
     const std::vector<std::vector<double>> gx = chooseGhosts();
     std::vector<std::vector<std::uint64_t>> answer(nRanks_);
     std::vector<std::vector<double>> om(nRanks_);

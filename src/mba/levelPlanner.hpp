@@ -50,13 +50,13 @@ class levelPlanner
 
     void startLevel(int k);
     void ownTiles();
-    bool readByEvaluation(const std::vector<std::vector<std::uint64_t>>& wanted,
-                          const std::function<bool(const levelPlan<D>&)>& isRead);
+    void findAskedTiles(const std::vector<std::vector<std::uint64_t>>& wanted);
+    bool readByEvaluation(const std::function<bool(const levelPlan<D>&)>& isRead);
     void ownOmega();
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
     std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
-    void answerRequests(const std::vector<std::vector<std::uint64_t>>& wanted);
+    void answerRequests();
     std::vector<std::vector<double>> chooseGhosts();
     void assembleView();
     void sumOmega(const std::vector<std::int64_t>& ownToView);

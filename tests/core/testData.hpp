@@ -31,6 +31,16 @@ struct vectorWidth
 template <int D>
 using tileNodeMasks = std::map<std::array<std::int64_t, D + 1>, std::uint64_t>;
 
+/// The key of tile t, omega value j, in tileNodeMasks
+template <int D>
+std::array<std::int64_t, D + 1> tileNodeKey(const mba::index<D>& t, int j)
+{
+    std::array<std::int64_t, D + 1> key;
+    std::copy(t.begin(), t.end(), key.begin());
+    key[D] = j;
+    return key;
+}
+
 /// The nodes of the level of scale s where a control point of ctrl has a
 /// weight w with w*w > 0, its weights multiplied in the order of the
 /// directions as the plan multiplies them, found node by node (the oracle of
@@ -75,13 +85,8 @@ tileNodeMasks<D> markedNodes(const mba::levelPlan<D>& L, int per)
     for (std::int64_t id = 0; id < L.view.size(); ++id)
     {
         const mba::index<D> t = L.view.coord(L.view.keyOf(id));
-        std::array<std::int64_t, D + 1> key;
-        std::copy(t.begin(), t.end(), key.begin());
         for (int j = 0; j < per; ++j)
-        {
-            key[D] = j;
-            if (L.coefficientNodes[id*per + j]) nodes[key] = L.coefficientNodes[id*per + j];
-        }
+            if (L.coefficientNodes[id*per + j]) nodes[tileNodeKey<D>(t, j)] = L.coefficientNodes[id*per + j];
     }
     return nodes;
 }
@@ -90,10 +95,7 @@ tileNodeMasks<D> markedNodes(const mba::levelPlan<D>& L, int per)
 template <int D>
 std::uint64_t nodesAt(const tileNodeMasks<D>& masks, const mba::index<D>& t, int j)
 {
-    std::array<std::int64_t, D + 1> key;
-    std::copy(t.begin(), t.end(), key.begin());
-    key[D] = j;
-    const auto it = masks.find(key);
+    const auto it = masks.find(tileNodeKey<D>(t, j));
     return it == masks.end() ? 0 : it->second;
 }
 
