@@ -164,13 +164,14 @@ indexBox<D> flatEvaluator<D>::evalNodeBox(int k) const
 }
 
 template <int D>
-void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine, int nRanks)
+void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine,
+                              const trendLattice<D>& trend, int nRanks)
 {
     flatLevel_ = -1;
     if (eval_.size() == 0) return;
-    const int m = chooseFlatLevel(nLevels);
+    const int m = chooseFlatLevel(nLevels, trend);
     if (m < 0) return;
-    foldLevels(levels, m, affine);
+    foldLevels(levels, nLevels, m, affine, trend);
     flatLevel_ = m;
     // Which finer levels have coefficients at each evaluation point: the
     // same as long as the levels and flatLevel_ are
@@ -182,20 +183,22 @@ void flatEvaluator<D>::update(std::deque<levelPlan<D>>& levels, int nLevels, con
 }
 
 /// The finest of the first nLevels levels whose node box has at most
-/// flatNodeBudget() nodes; -1: none
+/// flatNodeBudget() nodes, and at least the trend's level (a trend has no
+/// levels of its own to be added point by point); -1: none
 template <int D>
-int flatEvaluator<D>::chooseFlatLevel(int nLevels) const
+int flatEvaluator<D>::chooseFlatLevel(int nLevels, const trendLattice<D>& trend) const
 {
     const double budget = flatNodeBudget(eval_.size());
     int m = -1;
     while (m + 1 < nLevels && boxNodes<D>(evalNodeBox(m + 1)) <= budget) ++m;
-    return m;
+    return std::max(m, trend.level);
 }
 
-/// flatPhi_: the affine approximation and levels 0..m, refined to level m
-/// on its node box, summed
+/// flatPhi_: the affine approximation, the trend and levels 0..m (those of
+/// the first nLevels), refined to level m on its node box, summed
 template <int D>
-void flatEvaluator<D>::foldLevels(const std::deque<levelPlan<D>>& levels, int m, const affineFit<D>& affine)
+void flatEvaluator<D>::foldLevels(const std::deque<levelPlan<D>>& levels, int nLevels, int m,
+                                  const affineFit<D>& affine, const trendLattice<D>& trend)
 {
     indexBox<D> gb;
     for (int k = 0; k <= m; ++k)
@@ -204,9 +207,21 @@ void flatEvaluator<D>::foldLevels(const std::deque<levelPlan<D>>& levels, int m,
         if (k == 0) addAffine(fb, affine);
         else refine<D>(flatPhi_, gb, fb, nc_, refineScratch_);
         gb = fb;
-        addLevelInBox(levels[k], gb);
+        if (k == trend.level) addTrend(gb, trend);
+        if (k < nLevels) addLevelInBox(levels[k], gb);
     }
     flatBox_ = gb;
+}
+
+/// flatPhi_ (on the node box b of the trend's level) += the trend's coefficients
+template <int D>
+void flatEvaluator<D>::addTrend(const indexBox<D>& b, const trendLattice<D>& trend)
+{
+    forEachIndex<D>(b, [&](const index<D>& j) {
+        const double* p = &trend.phi[std::size_t(boxIndex<D>(trend.box, j))*nc_];
+        double* o = &flatPhi_[boxIndex<D>(b, j)*nc_];
+        for (int c = 0; c < nc_; ++c) o[c] += p[c];
+    });
 }
 
 /// flatPhi_ on the level-0 node box b: the affine approximation. Cubic

@@ -12,6 +12,7 @@
 
 #include "affine.hpp"
 #include "levelPlan.hpp"
+#include "trendLattice.hpp"
 
 #include <utility>
 
@@ -54,8 +55,10 @@ class flatEvaluator
     mutable hugeVector<double> sweptValues_;
 
     indexBox<D> evalNodeBox(int k) const;
-    int chooseFlatLevel(int nLevels) const;
-    void foldLevels(const std::deque<levelPlan<D>>& levels, int m, const affineFit<D>& affine);
+    int chooseFlatLevel(int nLevels, const trendLattice<D>& trend) const;
+    void foldLevels(const std::deque<levelPlan<D>>& levels, int nLevels, int m, const affineFit<D>& affine,
+                    const trendLattice<D>& trend);
+    void addTrend(const indexBox<D>& b, const trendLattice<D>& trend);
     void addAffine(const indexBox<D>& b, const affineFit<D>& affine);
     void addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b);
     bool coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid, double w[3]) const;
@@ -71,11 +74,13 @@ public:
         eval_(eval), ctrl_(ctrl), dom_(dom), nc_(ctrl.nComponents)
     {}
 
-    /// Rebuilds the flat lattice after a fit of the first nLevels of levels,
-    /// and, when the planned levels changed, which finer levels each point
-    /// needs; then also which points of separated levels must be stored in
-    /// every fit (levelPlan::readEveryFit). nRanks: the communicator's size
-    void update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine, int nRanks);
+    /// Rebuilds the flat lattice after a fit of the first nLevels of levels
+    /// (over the trend and the affine start), and, when the planned levels
+    /// changed, which finer levels each point needs; then also which points
+    /// of separated levels must be stored in every fit
+    /// (levelPlan::readEveryFit). nRanks: the communicator's size
+    void update(std::deque<levelPlan<D>>& levels, int nLevels, const affineFit<D>& affine,
+                const trendLattice<D>& trend, int nRanks);
 
     /// Whether a node of L with coefficients lies in the stencil of one of
     /// this rank's evaluation points, in a component the points' mask reads

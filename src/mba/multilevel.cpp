@@ -7,6 +7,7 @@
 #include "flatEvaluator.hpp"
 #include "levelApply.hpp"
 #include "stencilKernels.hpp"
+#include "trendLattice.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -48,6 +49,7 @@ struct multilevel<D>::state
     controlPoints<D> ctrl;              ///< this rank's control points, their masks, in spatial order
     evaluationPoints<D> eval;           ///< this rank's evaluation points, in the sweep's order
     domain<D> dom;                      ///< the lattices' domain (all ranks' points, padded)
+    trendLattice<D> trend;              ///< the trend under the affine start (fit with a trend)
     affineFit<D> affine;                ///< the affine start (none unless parameters.affine)
     queryClusters<D> clusters;          ///< this rank's query points in clusters (parallel only)
     std::deque<levelPlan<D>> levels;    ///< the levels planned so far (a fit plans those it needs)
@@ -66,6 +68,7 @@ struct multilevel<D>::state
     void checkInput() const;
     void findDomain(const box<D>* bounds);
     double checkValues(const std::vector<double>& values) const;
+    void setTrend(int k, const std::vector<double>& coefficients);
     void startResiduals(const std::vector<double>& values);
     void residualStats(double& maxr, double& rms) const;
     void addLevels(const double* x, double* out, int nLevels) const;
@@ -192,14 +195,51 @@ double multilevel<D>::state::checkValues(const std::vector<double>& values) cons
     return vmax;
 }
 
-/// residuals = values minus the affine start (solved for them first)
+/// The trend of the next fits (k < 0: none); throws (collectively) on a
+/// level out of range, a wrong count or a coefficient that is not finite
+template <int D>
+void multilevel<D>::state::setTrend(int k, const std::vector<double>& coefficients)
+{
+    if (k < 0)
+    {
+        trend = trendLattice<D>();
+        return;
+    }
+    collectively(comm, [&] {
+        precondition(k <= 16, "mba: the trend's level must be in [0, 16], got " + std::to_string(k));
+        const indexBox<D> b = trendLattice<D>::nodeBox(dom, k);
+        const double n = boxNodes<D>(b)*ctrl.nComponents;
+        precondition(double(coefficients.size()) == n,
+            "mba: " + std::to_string(coefficients.size()) + " trend coefficients, expected "
+            + std::to_string(std::int64_t(n)) + " (level " + std::to_string(k) + " nodes x components)");
+        for (std::size_t i = 0; i < coefficients.size(); ++i)
+            if (!std::isfinite(coefficients[i]))
+                precondition(false, "mba: trend coefficient " + std::to_string(i) + " is not finite");
+        trend.level = k;
+        trend.box = b;
+        trend.phi = coefficients;
+    });
+}
+
+/// residuals = values minus the trend and the affine start (solved for
+/// what the trend leaves first)
 template <int D>
 void multilevel<D>::state::startResiduals(const std::vector<double>& values)
 {
     const int nc = ctrl.nComponents;
     residuals = values;
+    if (trend.active())
+    {
+        for (std::size_t i = 0; i < ctrl.x.size; ++i)
+        {
+            if (!ctrl.active[i]) continue;
+            double g[3] = {0, 0, 0};
+            trend.addAt(dom.local0(ctrl.x[i]), nc, g);
+            for (int c = 0; c < nc; ++c) residuals[i*nc + c] -= g[c];
+        }
+    }
     if (!parameters.affine) return;
-    affine.solve(comm, ctrl.x, ctrl.mask, values);
+    affine.solve(comm, ctrl.x, ctrl.mask, residuals);
     for (std::size_t i = 0; i < ctrl.x.size; ++i)
     {
         double g[3] = {0, 0, 0};
@@ -240,9 +280,17 @@ void multilevel<D>::state::residualStats(double& maxr, double& rms) const
 template <int D>
 const fitReport& multilevel<D>::fit(const std::vector<double>& values)
 {
+    return fit(values, -1, std::vector<double>());
+}
+
+template <int D>
+const fitReport& multilevel<D>::fit(const std::vector<double>& values, int trendLevel,
+                                   const std::vector<double>& trend)
+{
     const double t0 = now();
     state& s = self();
     const double vmax = s.checkValues(values);
+    s.setTrend(trendLevel, trend);
     fitReport& rep = s.report;
     rep = fitReport();
     rep.maxValue = s.comm.max(vmax);
@@ -280,7 +328,7 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
         ++k;
     }
     rep.levels = k;
-    s.evaluator.update(s.levels, k, s.affine, s.comm.size());
+    s.evaluator.update(s.levels, k, s.affine, s.trend, s.comm.size());
     rep.maxResidual = maxr;
     rep.rmsResidual = rms;
     rep.converged = maxr <= rep.threshold;
@@ -288,13 +336,14 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values)
     return rep;
 }
 
-/// Adds the affine start and the first nLevels levels at x, their tiles
+/// Adds the affine start, the trend and the first nLevels levels at x, their tiles
 /// looked up point by point
 template <int D>
 void multilevel<D>::state::addLevels(const double* x, double* out, int nLevels) const
 {
     affine.addTo(x, out);
     const point<D> u0 = dom.local0(x);
+    trend.addAt(u0, ctrl.nComponents, out);
     for (int k = 0; k < nLevels; ++k)
     {
         const levelPlan<D>& L = levels[k];
@@ -349,6 +398,20 @@ void multilevel<D>::evaluateControl(std::vector<double>& out) const
 }
 
 template <int D>
+std::vector<double> multilevel<D>::latticeNodes(int k) const
+{
+    const domain<D>& dom = self().dom;
+    precondition(k >= 0 && k <= 16, "mba: the trend's level must be in [0, 16], got " + std::to_string(k));
+    const double h = std::ldexp(dom.h0, -k);
+    std::vector<double> x;
+    x.reserve(std::size_t(boxNodes<D>(trendLattice<D>::nodeBox(dom, k)))*D);
+    forEachIndex<D>(trendLattice<D>::nodeBox(dom, k), [&](const index<D>& j) {
+        for (int d = 0; d < D; ++d) x.push_back(dom.lo[d] + double(j[d] - 1)*h);
+    });
+    return x;
+}
+
+template <int D>
 const domain<D>& multilevel<D>::dom() const
 {
     return self().dom;
@@ -378,7 +441,8 @@ template <int D>
 std::int64_t multilevel<D>::bytes() const
 {
     const state& s = self();
-    std::int64_t b = std::int64_t(s.residuals.capacity()*sizeof(double)) + s.ctrl.bytes() + s.eval.bytes()
+    std::int64_t b = std::int64_t((s.residuals.capacity() + s.trend.phi.capacity())*sizeof(double))
+        + s.ctrl.bytes() + s.eval.bytes()
         + s.applier.bytes() + s.evaluator.bytes();
     for (const levelPlan<D>& L : s.levels) b += L.stats.bytes;
     return b;

@@ -24,6 +24,7 @@
 // levelPlan.hpp (a level's plan: tiles, buckets, requests, ghosts, the
 // separation test; levelPlanner.hpp the planner that makes it), levelApply.hpp (a level's apply in every fit),
 // flatEvaluator.hpp with subdivision.hpp and plainLattice.hpp (evaluation),
+// trendLattice.hpp (a trend under the levels: fit with a trend),
 // lattice.hpp and stencilKernels.hpp (tiled lattices and their kernels).
 #ifndef MBA_MULTILEVEL_HPP
 #define MBA_MULTILEVEL_HPP
@@ -165,6 +166,21 @@ public:
     /// Fit the control values (point x component; unconstrained components are
     /// ignored). Collective. Repeated fits reuse the plan.
     const fitReport& fit(const std::vector<double>& values);
+
+    /// The same over a trend: the cubic B-spline of level k whose coefficients
+    /// are trend (node x component, at the nodes latticeNodes(k) lists, the
+    /// same on every rank) is subtracted at the control points before the
+    /// affine start and the levels, and added back in every evaluation (at no
+    /// cost per evaluation point: it joins the coarse levels). A smooth trend
+    /// sampled there (a thin-plate spline through a subset of the control
+    /// points, say) then shapes the field away from the control points, where
+    /// the levels fall back towards the smooth interpolation of all the data.
+    /// Collective.
+    const fitReport& fit(const std::vector<double>& values, int k, const std::vector<double>& trend);
+
+    /// The nodes of level k's lattice over the whole domain (node x coordinate,
+    /// the last direction fastest): where fit() takes a trend's coefficients
+    std::vector<double> latticeNodes(int k) const;
 
     // The evaluations are const but fill caches (the coefficients a fit
     // leaves for later, a scratch array): one thread at a time per object.

@@ -1,4 +1,5 @@
 #include "rbfInterpolant.hpp"
+#include "collectively.hpp"
 
 #include <algorithm>
 #include <array>
@@ -62,15 +63,6 @@ double now()
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-template <class F>
-void collectively(const mba::communicator& comm, F&& f)
-{
-    std::string err;
-    try { f(); }
-    catch (const std::invalid_argument& e) { err = e.what(); }
-    comm.check(err.empty(), err);
-}
-
 } // namespace
 
 template <int D>
@@ -99,7 +91,7 @@ interpolant<D>::interpolant(const mba::communicator& comm, const params& p, int 
     comm_(comm), p_(p), nc_(nComponents)
 {
     const double t0 = now();
-    collectively(comm_, [&] {
+    mba::collectively(comm_, [&] {
         p_.validate();
         precondition(nc_ >= 1 && nc_ <= 3, "rbf: 1 to 3 value components, got " + std::to_string(nc_));
         for (std::size_t i = 0; i < control.size; ++i)
@@ -177,7 +169,7 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
     const long m = long(centres.size());
     const int np = p_.polynomial ? D + 1 : 0;
     const long n = m + (m > 0 ? np : 0);
-    collectively(comm_, [&] {
+    mba::collectively(comm_, [&] {
         precondition(m <= p_.maxPoints,
             "rbf: " + std::to_string(m) + " control points exceed maxPoints " + std::to_string(p_.maxPoints)
             + "; the dense system would need " + std::to_string(double(n)*n*8/1048576.0) + " MB per rank"
@@ -228,7 +220,7 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
     }
     stats_.rcond = rcond;
     stats_.bytes = double(lu_.size())*sizeof(double);
-    collectively(comm_, [&] {
+    mba::collectively(comm_, [&] {
         std::ostringstream msg;
         msg << "rbf: the " << n << "x" << n << " " << kernelName(p_.function)
             << " system is singular or ill-conditioned (reciprocal condition " << rcond
@@ -255,7 +247,7 @@ void interpolant<D>::solve(const std::vector<double>& v)
 template <int D>
 void interpolant<D>::fit(const std::vector<double>& values)
 {
-    collectively(comm_, [&] {
+    mba::collectively(comm_, [&] {
         precondition(values.size() == localToGlobal_.size()*nc_,
             "rbf: " + std::to_string(values.size()) + " control values, expected "
             + std::to_string(localToGlobal_.size()*nc_));
@@ -341,6 +333,47 @@ void interpolant<D>::evaluate(pointsView<D> x, std::vector<double>& out) const
 {
     out.assign(x.size*nc_, 0.0);
     for (std::size_t i = 0; i < x.size; ++i) evaluateAt(x[i], &out[i*nc_]);
+}
+
+template <int D>
+std::vector<double> interpolant<D>::basisAt(pointsView<D> x) const
+{
+    const long m = long(centres_.size()), n = stats_.size;
+    std::vector<double> b(x.size*std::size_t(n));
+    const double r2scale = p_.function == kernel::thinPlateSpline ? 1/(scale_*scale_) : 1.0;
+    for (std::size_t q = 0; q < x.size && n > 0; ++q)
+    {
+        double* row = &b[q*std::size_t(n)];
+        for (long j = 0; j < m; ++j)
+        {
+            const point<D>& xj = x_[centres_[j]];
+            double r2 = 0;
+            for (int d = 0; d < D; ++d) r2 += (x[q][d] - xj[d])*(x[q][d] - xj[d]);
+            row[j] = phi(r2*r2scale);
+        }
+        if (p_.polynomial)
+        {
+            row[m] = 1;
+            for (int d = 0; d < D; ++d) row[m + 1 + d] = (x[q][d] - lo_[d])/scale_;
+        }
+    }
+    return b;
+}
+
+template <int D>
+void interpolant<D>::evaluate(const std::vector<double>& basis, std::vector<double>& out) const
+{
+    const std::size_t n = std::size_t(stats_.size), rows = n ? basis.size()/n : 0;
+    out.assign(rows*nc_, 0.0);
+    for (std::size_t q = 0; q < rows; ++q)
+        for (int c = 0; c < nc_; ++c)
+        {
+            const double* a = &coeff_[std::size_t(c)*n];
+            const double* row = &basis[q*n];
+            double s = 0;
+            for (std::size_t j = 0; j < n; ++j) s += row[j]*a[j];
+            out[q*nc_ + c] = s;
+        }
 }
 
 template class interpolant<2>;

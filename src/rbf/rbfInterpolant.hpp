@@ -104,6 +104,14 @@ public:
     /// The interpolant at points (point x component)
     void evaluate(pointsView<D> x, std::vector<double>& out) const;
 
+    /// Its basis at the points x (point x (the centres' kernels, then the
+    /// polynomial's terms)), kept by the caller for evaluations at the same
+    /// points after each fit: a product per value, no kernel per centre
+    std::vector<double> basisAt(pointsView<D> x) const;
+
+    /// The interpolant at the points whose basisAt() basis is (point x component)
+    void evaluate(const std::vector<double>& basis, std::vector<double>& out) const;
+
     const systemStats& stats() const { return stats_; }
 };
 

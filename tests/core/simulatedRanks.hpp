@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <limits>
 
 namespace bsmTest {
@@ -54,6 +55,10 @@ struct problem
     std::vector<std::vector<mba::levelStats>>* stats = nullptr;   ///< per rank, when given
     std::vector<std::uint8_t> evaluationMask;                ///< per evaluation point x component (empty: all)
     std::vector<mba::fitReport>* reports = nullptr;               ///< per rank, when given
+    /// A trend at the nodes of level trendLevel (-1: none): its coefficient
+    /// at node x, component c
+    int trendLevel = -1;
+    std::function<double(const double* x, int c)> trend;
 };
 
 /// Values at every evaluation point (global order) from P ranks
@@ -88,8 +93,15 @@ std::vector<double> solve(int P, partition how, const std::vector<mba::point<D>>
                 eml.insert(eml.end(), &pb.evaluationMask[i*pb.nc], &pb.evaluationMask[i*pb.nc] + pb.nc);
         }
         mba::multilevel<D> m(comm, pb.p, pb.nc, cl, ml, el, eml);
-        m.fit(vl);
-        m.fit(vl);   // a second apply through the plan
+        std::vector<double> t;
+        if (pb.trendLevel >= 0)
+        {
+            const std::vector<double> nodes = m.latticeNodes(pb.trendLevel);
+            for (std::size_t i = 0; i < nodes.size(); i += D)
+                for (int k = 0; k < pb.nc; ++k) t.push_back(pb.trend(&nodes[i], k));
+        }
+        m.fit(vl, pb.trendLevel, t);
+        m.fit(vl, pb.trendLevel, t);   // a second apply through the plan
         std::vector<double> o;
         m.evaluate(o);
         if (pb.stats) (*pb.stats)[comm.rank()] = m.stats();

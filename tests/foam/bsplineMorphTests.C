@@ -200,6 +200,16 @@ TEST_CASE("An affine motion of the walls moves every point by exactly that motio
         autoPtr<motionSolver> solver = bsplineSolver("");
         requireAffine(solver.ref(), 1e-13);
     }
+    SECTION("multilevelBSpline over a thin-plate spline")
+    {
+        // (the spline's linear polynomial holds the motion, to its solve's
+        // round-off; the B-splines reproduce its samples exactly)
+        autoPtr<motionSolver> solver = bsplineSolver
+        (
+            "initialApproximation thinPlateSpline; thinPlateSplineCoeffs { grid 4; level 2; }"
+        );
+        requireAffine(solver.ref(), 1e-10);
+    }
     SECTION("RBF")
     {
         autoPtr<motionSolver> solver = solverOf("RBF", "");
@@ -395,7 +405,11 @@ TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bs
     CHECK_THAT(errorOf("bucketTiles 0;"), Contains("bucketTiles") && Contains("at least 1"));
     const std::string approx = errorOf("initialApproximation quadratic;");
     CHECK_THAT(approx, Contains("'initialApproximation' is 'quadratic'") && Contains("affine") && Contains("none")
-        && Contains("default affine"));
+        && Contains("thinPlateSpline") && Contains("default affine"));
+    const std::string tps = "initialApproximation thinPlateSpline; thinPlateSplineCoeffs ";
+    CHECK_THAT(errorOf(tps + "{ grid 0; }"), Contains("'grid' is 0") && Contains("from 1 to 32") && Contains("default 8"));
+    CHECK_THAT(errorOf(tps + "{ level 6; }"), Contains("'level' is 6") && Contains("from 0 to 5") && Contains("default 4"));
+    CHECK(errorOf(tps + "{ grid 6; level 3; }") == "no error");
     const std::string inverted = errorOf("invertedCells maybe;");
     CHECK_THAT(inverted, Contains("'invertedCells' is 'maybe'") && Contains("fatal") && Contains("warn")
         && Contains("default fatal"));

@@ -352,6 +352,19 @@ void Foam::boundaryConstraints::addPoints(const labelList& points)
     {
         boundaryPoints_ = all.sortedToc();
     }
+    added_.resize(pMesh_().nPoints());
+    added_.set(points);
+}
+
+
+std::vector<std::uint8_t> Foam::boundaryConstraints::addedControls() const
+{
+    std::vector<std::uint8_t> added(controlPoints_.size(), 0);
+    forAll(controlPoints_, i)
+    {
+        added[i] = added_.test(controlPoints_[i]);
+    }
+    return added;
 }
 
 

@@ -22,6 +22,7 @@ License
 #include "OStringStream.H"
 #include "Enum.H"
 #include "clockTime.H"
+#include "thinPlateTrend.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -48,11 +49,12 @@ namespace Foam
 
     namespace
     {
-        enum class initialApproximation { affine, none };
+        enum class initialApproximation { affine, none, thinPlateSpline };
         const Enum<initialApproximation> initialApproximationNames
         ({
             { initialApproximation::affine, "affine" },
             { initialApproximation::none, "none" },
+            { initialApproximation::thinPlateSpline, "thinPlateSpline" },
         });
 
         const Enum<mba::params::exchangeMode> exchangeNames
@@ -93,13 +95,23 @@ namespace Foam
 
             mba::multilevel<D> plan_;
 
+            //- initialApproximation thinPlateSpline: the spline (else
+            //  null), the level whose nodes sample it, the nodes and the
+            //  samples
+            std::unique_ptr<rbf::thinPlateTrend<D>> trend_;
+            const int trendLevel_;
+            const std::vector<double> trendNodes_;
+            std::vector<double> trendValues_;
+
             //- Whether a fit that stopped above its threshold was reported
             bool warned_ = false;
 
         public:
 
             //- evalRead: per evaluation point x direction, whether the
-            //  solver reads its value (params.stopUnread)
+            //  solver reads its value (params.stopUnread); trendGrid: the
+            //  thin-plate spline's grid (0: none), sampled at the nodes of
+            //  level trendLevel
             bsplineInterpolator
             (
                 const mba::communicator& comm,
@@ -108,7 +120,9 @@ namespace Foam
                 const pointField& points0,
                 const double* evalXyz,
                 const std::size_t nEval,
-                std::vector<std::uint8_t> evalRead
+                std::vector<std::uint8_t> evalRead,
+                const label trendGrid,
+                const label trendLevel
             )
             :
                 controlXyz_(controlCoordinates(bc, points0)),
@@ -117,8 +131,42 @@ namespace Foam
                     comm, params, D,
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                     bc.mask(), mba::pointsView<D>(evalXyz, nEval), std::move(evalRead)
+                ),
+                trendLevel_(trendGrid > 0 ? trendLevel : -1),
+                trendNodes_
+                (
+                    trendGrid > 0 ? plan_.latticeNodes(trendLevel) : std::vector<double>()
                 )
-            {}
+            {
+                if (trendGrid > 0)
+                {
+                    // (the grid over the lattice domain, which every rank shares)
+                    const mba::domain<D>& dom = plan_.dom();
+                    mba::box<D> b;
+                    for (int d = 0; d < D; ++d)
+                    {
+                        b.lo[d] = dom.lo[d];
+                        b.hi[d] = dom.lo[d] + dom.n0[d]*dom.h0;
+                    }
+                    trend_.reset
+                    (
+                        new rbf::thinPlateTrend<D>
+                        (
+                            comm, D,
+                            mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
+                            bc.mask(), bc.addedControls(), b, trendGrid,
+                            mba::pointsView<D>(trendNodes_.data(), trendNodes_.size()/D)
+                        )
+                    );
+                    Info<< multilevelBSplineMotionSolver::typeName
+                        << ": thinPlateSpline through " << trend_->centres()
+                        << " centres (grid " << trendGrid << ", "
+                        << trend_->systems() << " system"
+                        << (trend_->systems() == 1 ? "" : "s")
+                        << "), sampled at the " << trendNodes_.size()/D
+                        << " nodes of level " << trendLevel << endl;
+                }
+            }
 
             //- Fit the control values, evaluate at the evaluation points
             virtual interpolationReport interpolate
@@ -140,10 +188,16 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     std::vector<double>& values
 )
 {
-    scalar evalSeconds = 0;
+    scalar evalSeconds = 0, trendSeconds = 0;
     try
     {
-        plan_.fit(bc.values());
+        if (trend_)
+        {
+            const clockTime timer;
+            trend_->sample(bc.values(), trendValues_);
+            trendSeconds = timer.elapsedTime();
+        }
+        plan_.fit(bc.values(), trendLevel_, trendValues_);
         const clockTime timer;
         plan_.evaluate(values);
         evalSeconds = timer.elapsedTime();
@@ -230,8 +284,12 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
         << " (threshold " << r.threshold << reached
         << "), " << label(nodes) << " lattice nodes, plan " << planMB << " MB, "
         << label(bytes) << " bytes exchanged (" << label(bytesMax) << " by one rank) in "
-        << label(messages) << " messages (" << label(messagesMax) << " by one rank), fit "
-        << r.seconds << " s, evaluation " << evalSeconds << " s";
+        << label(messages) << " messages (" << label(messagesMax) << " by one rank), ";
+    if (trend_)
+    {
+        os  << "thin-plate spline " << trendSeconds << " s, ";
+    }
+    os  << "fit " << r.seconds << " s, evaluation " << evalSeconds << " s";
     interpolationReport report;
     report.summary = os.str();
     report.add("levels", r.levels);
@@ -248,6 +306,10 @@ Foam::interpolationReport Foam::bsplineInterpolator<D>::interpolate
     report.add("bytesOneRank", bytesMax);
     report.add("messages", messages);
     report.add("messagesOneRank", messagesMax);
+    if (trend_)
+    {
+        report.add("thinPlateSpline_s", trendSeconds);
+    }
     report.add("fit_s", r.seconds);
     report.add("evaluation_s", evalSeconds);
     return report;
@@ -265,12 +327,32 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     params_.maxLevels = coeffsInput::getInRange<label>(dict, "maxLevels", 12, 1, 30);
     params_.initialGrid =
         coeffsInput::getInRange<label>(dict, "initialGrid", 1, 1, 1 << 20);
-    params_.affine =
-        coeffsInput::getEnum
-        (
-            dict, "initialApproximation", initialApproximationNames,
-            initialApproximation::affine
-        ) == initialApproximation::affine;
+    const initialApproximation start = coeffsInput::getEnum
+    (
+        dict, "initialApproximation", initialApproximationNames,
+        initialApproximation::affine
+    );
+    // (the thin-plate spline's linear polynomial holds the affine part; the
+    // affine start then fits what the sampled spline leaves)
+    params_.affine = start != initialApproximation::none;
+    trendGrid_ = 0;
+    if (start == initialApproximation::thinPlateSpline)
+    {
+        const dictionary& tps = dict.optionalSubDict("thinPlateSplineCoeffs");
+        trendGrid_ = coeffsInput::getInRange<label>(tps, "grid", 8, 1, 32);
+        trendLevel_ = coeffsInput::getInRange<label>(tps, "level", 4, 0, 5);
+        if (&tps != &dict)
+        {
+            coeffsInput::warnUnknown(tps, {"grid", "level"});
+        }
+    }
+    else if (dict.found("thinPlateSplineCoeffs"))
+    {
+        IOWarningInFunction(dict)
+            << "thinPlateSplineCoeffs is read with initialApproximation"
+            << " thinPlateSpline only, here "
+            << initialApproximationNames[start] << ": ignored" << endl;
+    }
     params_.bucketTiles = coeffsInput::getInRange<label>(dict, "bucketTiles", 32, 1);
     params_.exchange = coeffsInput::getEnum
     (
@@ -281,7 +363,7 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     warnUnknownKeywords
     ({
         "tolerance", "relativeTolerance", "maxLevels", "initialGrid",
-        "initialApproximation", "bucketTiles", "exchange"
+        "initialApproximation", "thinPlateSplineCoeffs", "bucketTiles", "exchange"
     });
 }
 
@@ -346,12 +428,12 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read)));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read)));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_));
         }
         else
         {
