@@ -365,15 +365,26 @@ void interpolant<D>::evaluate(const std::vector<double>& basis, std::vector<doub
 {
     const std::size_t n = std::size_t(stats_.size), rows = n ? basis.size()/n : 0;
     out.assign(rows*nc_, 0.0);
+    // A row read once for every component (at most 3), in four independent
+    // sums per component (the row comes from memory: the basis is megabytes)
     for (std::size_t q = 0; q < rows; ++q)
+    {
+        const double* row = &basis[q*n];
+        double s[3][4] = {};
+        std::size_t j = 0;
+        for (; j + 4 <= n; j += 4)
+            for (int c = 0; c < nc_; ++c)
+            {
+                const double* a = &coeff_[std::size_t(c)*n + j];
+                for (int k = 0; k < 4; ++k) s[c][k] += row[j + k]*a[k];
+            }
         for (int c = 0; c < nc_; ++c)
         {
-            const double* a = &coeff_[std::size_t(c)*n];
-            const double* row = &basis[q*n];
-            double s = 0;
-            for (std::size_t j = 0; j < n; ++j) s += row[j]*a[j];
-            out[q*nc_ + c] = s;
+            double t = (s[c][0] + s[c][1]) + (s[c][2] + s[c][3]);
+            for (std::size_t i = j; i < n; ++i) t += row[i]*coeff_[std::size_t(c)*n + i];
+            out[q*nc_ + c] = t;
         }
+    }
 }
 
 template class interpolant<2>;
