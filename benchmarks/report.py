@@ -98,6 +98,7 @@ def pyplot():
     return plt
 
 rigidLayers = "multilevelBSpline+rigidLayers"
+overSpline = rigidLayers + "+thinPlateSpline"
 def median(v):
     v = sorted(v)
     return 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
@@ -156,7 +157,7 @@ def tables(resultsPath, mdPath, imgDir, scaleN, plots):
     sizes = sorted({k[0] for k in runs})
     for n in sizes:
         b = (n, "multilevelBSpline", 1)
-        for s in ("multilevelBSpline", rigidLayers, "displacementLaplacian", "RBF"):
+        for s in ("multilevelBSpline", rigidLayers, overSpline, "displacementLaplacian", "RBF"):
             if (n, s, 1) not in runs: continue
             r = runs[(n, s, 1)]
             out.append("| %d | %s | %.3f | %.3f | %.3f | %s | %.0f | %s | %s | %s | %s | %s | %s |" % (
@@ -183,20 +184,20 @@ def tables(resultsPath, mdPath, imgDir, scaleN, plots):
     # multilevelBSpline with rigidLayers against without, serial: the solve
     # medians pooled over the same trials, each trial's ratio (the trials in the
     # order run), the first step, and where the solve goes
-    layered = [n for n in sizes if (n, rigidLayers, 1) in runs]
+    layered = [n for n in sizes if (n, rigidLayers, 1) in runs or (n, overSpline, 1) in runs]
     if layered:
         out += ["", "## multilevelBSpline with rigidLayers against without (single core; rigidLayers on top: innerDistance 0.06, outerDistance 0.08)", "",
                 "| cells | method | control points | rigid zone: points within outerDistance / innerDistance / outermost | first step s | solve s (median) | median of each trial | fit s | evaluation s | inverted-cell check s | the rest s | solve / multilevelBSpline's | each trial's | first step / multilevelBSpline's | steps with inverted cells (most in a step), each trial | invalid cells at the end |",
                 "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for n in layered:
             b = (n, "multilevelBSpline", 1)
-            for s in ("multilevelBSpline", rigidLayers):
+            for s in ("multilevelBSpline", rigidLayers, overSpline):
                 k = (n, s, 1)
                 if k not in runs: continue
                 r = runs[k]
                 part = lambda x: "%.3f" % median(r[x]) if r[x] else "-"
                 out.append("| %d | %s | %s | %s | %.3f | %.3f | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                    n**3, s, r["controls"], " / ".join(r["zone"]) if s == rigidLayers else "-", first(*k), solve(*k),
+                    n**3, s, r["controls"], " / ".join(r["zone"]) if s != "multilevelBSpline" else "-", first(*k), solve(*k),
                     ", ".join("%.3f" % x for x in r["trials"]), part("fit"), part("eval"), part("check"), part("rest"),
                     "%.2f" % (solve(*k) / solve(*b)) if b in runs else "-",
                     ", ".join("%.2f" % (x / y) for x, y in zip(r["trials"], runs[b]["trials"])) if b in runs else "-",

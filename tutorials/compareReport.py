@@ -13,8 +13,10 @@ tutorial case against the motion's amplitude).
         method and amplitude, and the largest amplitude each method survives:
         run completed, no invalid cell) and the plot PNG of the measures
         against the amplitude (AMPNAME its axis label; matplotlib)
+    compareReport.py label METHOD
+        the method's name in the tables (S/on/I: "S, rigidLayers on, I")
 
-A run's folder is ROWS's folder/<METHOD with '/' as '-'>-<AMPLITUDE> (as
+A run's folder is ROWS's folder/<METHOD with each '/' as '-'>-<AMPLITUDE> (as
 tutorials/compare makes it). The report takes the method, amplitude and
 status from ROWS and each run's measures from its folder's
 postProcessing/morphQuality.dat and morphQualityLayers.dat, by column name
@@ -30,7 +32,7 @@ QUALITY = ("maxNonOrth", "maxSkewness", "minDeterminant", "minVolRatio", "maxVol
            "meanLayerHeightChange", "worstLayerHeightChange", "meanLayerAngleChange", "worstLayerAngleChange")
 
 def runDir(rowsPath, method, amplitude):
-    return os.path.join(os.path.dirname(os.path.abspath(rowsPath)), method.replace("/", "-", 1) + "-" + amplitude)
+    return os.path.join(os.path.dirname(os.path.abspath(rowsPath)), method.replace("/", "-") + "-" + amplitude)
 
 def lastQuality(run):
     """The last row of the run's morphQuality.dat (None without one)"""
@@ -56,8 +58,9 @@ def row(method, amplitude, run, status):
                                    "%.6g %.6g" % layers if layers else "")
 
 def label(token):
-    solver, _, layers = token.partition("/")
-    return solver + (", rigidLayers " + layers if layers else "")
+    """S, S/on|off or S/on|off/I: the method's name in the tables"""
+    solver, layers, start = (token.split("/") + ["", ""])[:3]
+    return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "")
 
 def readRuns(rowsPath):
     """[(method label, amplitude, measures {name: value} or None, status)]"""
@@ -131,8 +134,10 @@ def main():
         print(row(*args))
     elif mode == "report":
         report(*args)
+    elif mode == "label":
+        print(label(*args))
     else:
-        sys.exit("compareReport.py: unknown mode %s (row, report)" % mode)
+        sys.exit("compareReport.py: unknown mode %s (row, report, label)" % mode)
 
 if __name__ == "__main__":
     main()
