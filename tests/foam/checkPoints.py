@@ -13,9 +13,11 @@
     checkPoints.py cyclic CASE box|sector    the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
                                              the box's x faces, the sector's sides) have displacements
                                              equal through the pair's transform at every written time
-    checkPoints.py tiltedSlip CASE           the sheared block of tests/foam/Alltest.d/tiltedSlip at
+    checkPoints.py tiltedSlip CASE [--planes-only]
+                                             the sheared block of tests/foam/Alltest.d/tiltedSlip at
                                              time 1: the walls' points on their tilted planes, the
                                              first cell layer following the wall, the pushed face
+                                             (--planes-only: the first alone)
     checkPoints.py wedge WEDGE TIME [PLANAR] [--tol T] [--axial]
                                              an axisymmetric case about the x axis (tests/foam/Alltest.d/
                                              wedge): no point moves across its meridian plane (those on
@@ -79,10 +81,11 @@ def cyclicPairs(case, kind):
               % (t, diff, moved))
         check(moved > 1e-4, "time %s: the cyclic points moved (largest %.3g), the check is not vacuous" % (t, moved))
 
-def tiltedSlip(case):
+def tiltedSlip(case, planesOnly=False):
     """tests/foam/Alltest.d/tiltedSlip: a block sheared so that its bottom and
     top are the planes z = 0.5 x and z = 1 + 0.5 x (slip walls), its left face
-    pushed 0.1 along x, its right face fixed; time 1"""
+    pushed 0.1 along x, its right face fixed; time 1. planesOnly: only that
+    the walls' points stay on their planes"""
     import math
     p0, p1 = pointsAt(case, "constant"), pointsAt(case, 1)
     n = (-0.5 / math.hypot(0.5, 1), 0.0, 1 / math.hypot(0.5, 1))
@@ -91,6 +94,8 @@ def tiltedSlip(case):
               for a, b in zip(p0, p1)
               if 0 < a[0] < 1 and (abs(a[2] - 0.5 * a[0]) < 1e-9 or abs(a[2] - 0.5 * a[0] - 1) < 1e-9))
     check(off < 1e-12, "bottom and top wall points stay on their planes (largest distance %.2e)" % off)
+    if planesOnly:
+        return
     # the first layer above the bottom wall follows it: its displacement normal
     # to the wall, relative to the wall point below. The pushed face's motion has
     # the normal component 0.1 (1 - x) |n_x| = 0.0447 (1 - x); projecting only the
@@ -254,7 +259,7 @@ def main():
     elif mode == "cyclic":
         cyclicPairs(sys.argv[2], sys.argv[3])
     elif mode == "tiltedSlip":
-        tiltedSlip(sys.argv[2])
+        tiltedSlip(sys.argv[2], planesOnly="--planes-only" in sys.argv)
     elif mode == "wedge":
         args = positionals()
         tol = tolOption()

@@ -569,7 +569,7 @@ void Foam::rigidLayers::addControls
         if (!fixed[pointi] && slides[pointi].first() > 0 && footFixed[j])
         {
             vector r = rigidMotion(j, zoneArm_[i]);
-            slides[pointi].constrainDisplacement(r);
+            r = slides[pointi].constrainDisplacement(r);
             bc.fix(pointi, r);
         }
     }
