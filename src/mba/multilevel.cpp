@@ -206,7 +206,6 @@ void multilevel<D>::state::setTrend(int k, const std::vector<double>& coefficien
         return;
     }
     collectively(comm, [&] {
-        precondition(k <= 16, "mba: the trend's level must be in [0, 16], got " + std::to_string(k));
         const indexBox<D> b = trendLattice<D>::nodeBox(dom, k);
         const double n = boxNodes<D>(b)*ctrl.nComponents;
         precondition(double(coefficients.size()) == n,
@@ -401,11 +400,11 @@ template <int D>
 std::vector<double> multilevel<D>::latticeNodes(int k) const
 {
     const domain<D>& dom = self().dom;
-    precondition(k >= 0 && k <= 16, "mba: the trend's level must be in [0, 16], got " + std::to_string(k));
+    const indexBox<D> b = trendLattice<D>::nodeBox(dom, k);
     const double h = std::ldexp(dom.h0, -k);
     std::vector<double> x;
-    x.reserve(std::size_t(boxNodes<D>(trendLattice<D>::nodeBox(dom, k)))*D);
-    forEachIndex<D>(trendLattice<D>::nodeBox(dom, k), [&](const index<D>& j) {
+    x.reserve(std::size_t(boxNodes<D>(b))*D);
+    forEachIndex<D>(b, [&](const index<D>& j) {
         for (int d = 0; d < D; ++d) x.push_back(dom.lo[d] + double(j[d] - 1)*h);
     });
     return x;

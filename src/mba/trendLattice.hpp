@@ -25,9 +25,11 @@ struct trendLattice
     bool active() const { return level >= 0; }
 
     /// Every node of level k over the domain: node j at x = lo + (j - 1) h_k,
-    /// j = 0 .. n0 2^k + 2 (the stencils of all points in the domain)
+    /// j = 0 .. n0 2^k + 2 (the stencils of all points in the domain); throws
+    /// std::invalid_argument for k outside [0, 16]
     static indexBox<D> nodeBox(const domain<D>& dom, int k)
     {
+        precondition(k >= 0 && k <= 16, "mba: the trend's level must be in [0, 16], got " + std::to_string(k));
         indexBox<D> b;
         for (int d = 0; d < D; ++d)
         {

@@ -312,10 +312,7 @@ void interpolant<D>::evaluateAt(const double* x, double* out) const
     const double r2scale = p_.function == kernel::thinPlateSpline ? 1/(scale_*scale_) : 1.0;
     for (long j = 0; j < m; ++j)
     {
-        const point<D>& xj = x_[centres_[j]];
-        double r2 = 0;
-        for (int d = 0; d < D; ++d) r2 += (x[d] - xj[d])*(x[d] - xj[d]);
-        const double f = phi(r2*r2scale);
+        const double f = kernelAt(x, j, r2scale);
         for (int c = 0; c < nc_; ++c) out[c] += coeff_[std::size_t(c)*n + j]*f;
     }
     if (p_.polynomial)
@@ -344,13 +341,7 @@ std::vector<double> interpolant<D>::basisAt(pointsView<D> x) const
     for (std::size_t q = 0; q < x.size && n > 0; ++q)
     {
         double* row = &b[q*std::size_t(n)];
-        for (long j = 0; j < m; ++j)
-        {
-            const point<D>& xj = x_[centres_[j]];
-            double r2 = 0;
-            for (int d = 0; d < D; ++d) r2 += (x[q][d] - xj[d])*(x[q][d] - xj[d]);
-            row[j] = phi(r2*r2scale);
-        }
+        for (long j = 0; j < m; ++j) row[j] = kernelAt(x[q], j, r2scale);
         if (p_.polynomial)
         {
             row[m] = 1;

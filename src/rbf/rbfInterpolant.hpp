@@ -86,6 +86,14 @@ class interpolant
     systemStats stats_;
 
     double phi(double r2) const;
+    /// phi at x for centre j (of centres_), the squared distance times r2scale
+    double kernelAt(const double* x, long j, double r2scale) const
+    {
+        const point<D>& xj = x_[centres_[j]];
+        double r2 = 0;
+        for (int d = 0; d < D; ++d) r2 += (x[d] - xj[d])*(x[d] - xj[d]);
+        return phi(r2*r2scale);
+    }
     void factor(const std::vector<std::size_t>& centres);
     void solve(const std::vector<double>& globalValues);
     void evaluateAt(const double* x, double* out) const;

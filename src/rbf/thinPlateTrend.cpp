@@ -80,8 +80,10 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
             if (std::lexicographical_compare(a, a + K, b, b + K)) std::copy(a, a + K, b);
         }
 
-    // Components whose slots hold the same points share a group
+    // Components whose slots hold the same points share a group; the bases
+    // kept: the samples times the centres and terms (at most 2^25 doubles)
     const long perComponent = long(nClasses)*nCells*K;
+    double basisValues = 0;
     for (int c = 0; c < nc_; ++c)
     {
         const double* mine = &best[c*perComponent];
@@ -100,6 +102,7 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
         g = &groups_.back();
         g->components.push_back(c);
         centres_ += used;
+        basisValues += double(samples.size)*double(used + D + 1);
         for (std::size_t i = 0; i < control.size; ++i)
         {
             if (!mask.empty() && !mask[i*nc_ + c]) continue;
@@ -113,14 +116,6 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
                 g->x.push_back(x);
             }
         }
-    }
-    // (the kept bases: the samples times the centres and terms, at most 2^25 doubles)
-    double basisValues = 0;
-    for (const group& g : groups_)
-    {
-        long nx = 0;
-        for (long s = 0; s < nClasses*nCells; ++s) nx += std::isfinite(best[(g.components[0]*nClasses*nCells + s)*K]);
-        basisValues += double(samples.size)*double(nx + D + 1);
     }
     mba::collectively(comm, [&] {
         mba::precondition(basisValues <= double(1L << 25), "rbf: the thin-plate trend's basis at its "
