@@ -44,18 +44,12 @@ struct trendLattice
     {
         if (!active()) return;
         const stencil<D> st = levelStencil<D>(u0, std::ldexp(1.0, level));
-        indexBox<D> sb;
-        for (int d = 0; d < D; ++d)
+        switch (nc)
         {
-            sb.lo[d] = st.base[d];
-            sb.hi[d] = st.base[d] + 3;
+            case 1: flatStencil<1, 2>(phi.data(), box, st, out); break;
+            case 2: flatStencil<2, 2>(phi.data(), box, st, out); break;
+            default: flatStencil<3, 2>(phi.data(), box, st, out);
         }
-        forEachIndex<D>(sb, [&](const index<D>& j) {
-            double w = 1;
-            for (int d = 0; d < D; ++d) w *= st.w[d][j[d] - st.base[d]];
-            const double* p = &phi[std::size_t(boxIndex<D>(box, j))*nc];
-            for (int c = 0; c < nc; ++c) out[c] += w*p[c];
-        });
     }
 };
 
