@@ -14,7 +14,7 @@ tutorial case against the motion's amplitude).
         run completed, no invalid cell) and the plot PNG of the measures
         against the amplitude (AMPNAME its axis label; matplotlib)
     compareReport.py label METHOD
-        the method's name in the tables (S/on/I: "S, rigidLayers on, I")
+        the method's name in the tables (S/on/I/L: "S, rigidLayers on, I level L")
 
 A run's folder is ROWS's folder/<METHOD with each '/' as '-'>-<AMPLITUDE> (as
 tutorials/compare makes it). The report takes the method, amplitude and
@@ -58,9 +58,10 @@ def row(method, amplitude, run, status):
                                    "%.6g %.6g" % layers if layers else "")
 
 def label(token):
-    """S, S/on|off or S/on|off/I: the method's name in the tables"""
-    solver, layers, start = (token.split("/") + ["", ""])[:3]
-    return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "")
+    """S, S/on|off, S/on|off/I or S/on|off/I/L: the method's name in the tables"""
+    solver, layers, start, level = (token.split("/") + ["", "", ""])[:4]
+    return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "") \
+        + (" level " + level if level else "")
 
 def readRuns(rowsPath):
     """[(method label, amplitude, measures {name: value} or None, status)]"""
