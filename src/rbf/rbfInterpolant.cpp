@@ -309,7 +309,7 @@ void interpolant<D>::evaluateAt(const double* x, double* out) const
 {
     const long m = long(centres_.size()), n = stats_.size;
     if (n == 0) return;
-    const double r2scale = p_.function == kernel::thinPlateSpline ? 1/(scale_*scale_) : 1.0;
+    const double r2scale = r2Scale();
     for (long j = 0; j < m; ++j)
     {
         const double f = kernelAt(x, j, r2scale);
@@ -337,7 +337,7 @@ std::vector<double> interpolant<D>::basisAt(pointsView<D> x) const
 {
     const long m = long(centres_.size()), n = stats_.size;
     std::vector<double> b(x.size*std::size_t(n));
-    const double r2scale = p_.function == kernel::thinPlateSpline ? 1/(scale_*scale_) : 1.0;
+    const double r2scale = r2Scale();
     for (std::size_t q = 0; q < x.size && n > 0; ++q)
     {
         double* row = &b[q*std::size_t(n)];

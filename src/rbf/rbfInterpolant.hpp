@@ -86,6 +86,9 @@ class interpolant
     systemStats stats_;
 
     double phi(double r2) const;
+    /// The factor of the squared distances that phi takes in an evaluation
+    /// (thinPlateSpline: in units of scale_)
+    double r2Scale() const { return p_.function == kernel::thinPlateSpline ? 1/(scale_*scale_) : 1.0; }
     /// phi at x for centre j (of centres_), the squared distance times r2scale
     double kernelAt(const double* x, long j, double r2scale) const
     {

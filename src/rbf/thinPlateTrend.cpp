@@ -48,6 +48,11 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
     std::vector<double> best(nSlots*K, std::numeric_limits<double>::infinity());
     std::vector<key> pointKey(control.size);
     std::vector<long> pointCell(control.size);
+    // (control point i's slot for component c, once its cell is known)
+    auto slotOf = [&](std::size_t i, int c) {
+        const long cls = classes.empty() ? 0 : classes[i];
+        return &best[((long(c)*nClasses + cls)*nCells + pointCell[i])*K];
+    };
     for (std::size_t i = 0; i < control.size; ++i)
     {
         long cell = 0;
@@ -63,11 +68,10 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
         k[0] = d2;
         for (int d = 0; d < D; ++d) k[1 + d] = control[i][d];
         pointCell[i] = cell;
-        const long cls = classes.empty() ? 0 : classes[i];
         for (int c = 0; c < nc_; ++c)
         {
             if (!mask.empty() && !mask[i*nc_ + c]) continue;
-            double* b = &best[((long(c)*nClasses + cls)*nCells + cell)*K];
+            double* b = slotOf(i, c);
             if (std::lexicographical_compare(k.begin(), k.end(), b, b + K)) std::copy(k.begin(), k.end(), b);
         }
     }
@@ -106,9 +110,7 @@ thinPlateTrend<D>::thinPlateTrend(const mba::communicator& comm, int nComponents
         for (std::size_t i = 0; i < control.size; ++i)
         {
             if (!mask.empty() && !mask[i*nc_ + c]) continue;
-            const long cls = classes.empty() ? 0 : classes[i];
-            const double* b = &best[((long(c)*nClasses + cls)*nCells + pointCell[i])*K];
-            if (std::equal(pointKey[i].begin(), pointKey[i].end(), b))
+            if (std::equal(pointKey[i].begin(), pointKey[i].end(), slotOf(i, c)))
             {
                 g->points.push_back(i);
                 point<D> x;

@@ -61,6 +61,18 @@ struct problem
     std::function<double(const double* x, int c)> trend;
 };
 
+/// The coefficients of a trend of level k for m's fit (node x component):
+/// f(x, c) at the nodes m.latticeNodes(k) lists
+template <int D, class F>
+std::vector<double> trendAtNodes(const mba::multilevel<D>& m, int k, int nc, F&& f)
+{
+    const std::vector<double> nodes = m.latticeNodes(k);
+    std::vector<double> t;
+    for (std::size_t i = 0; i < nodes.size(); i += D)
+        for (int c = 0; c < nc; ++c) t.push_back(f(&nodes[i], c));
+    return t;
+}
+
 /// Values at every evaluation point (global order) from P ranks
 template <int D>
 std::vector<double> solve(int P, partition how, const std::vector<mba::point<D>>& c, const std::vector<double>& v,
@@ -93,13 +105,8 @@ std::vector<double> solve(int P, partition how, const std::vector<mba::point<D>>
                 eml.insert(eml.end(), &pb.evaluationMask[i*pb.nc], &pb.evaluationMask[i*pb.nc] + pb.nc);
         }
         mba::multilevel<D> m(comm, pb.p, pb.nc, cl, ml, el, eml);
-        std::vector<double> t;
-        if (pb.trendLevel >= 0)
-        {
-            const std::vector<double> nodes = m.latticeNodes(pb.trendLevel);
-            for (std::size_t i = 0; i < nodes.size(); i += D)
-                for (int k = 0; k < pb.nc; ++k) t.push_back(pb.trend(&nodes[i], k));
-        }
+        const std::vector<double> t =
+            pb.trendLevel >= 0 ? trendAtNodes<D>(m, pb.trendLevel, pb.nc, pb.trend) : std::vector<double>();
         m.fit(vl, pb.trendLevel, t);
         m.fit(vl, pb.trendLevel, t);   // a second apply through the plan
         std::vector<double> o;

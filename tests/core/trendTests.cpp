@@ -58,16 +58,6 @@ double bsplineOf(const domain<D>& dom, int k, F&& f, const double* x, int c)
     return sum;
 }
 
-template <int D, class F>
-std::vector<double> trendAtNodes(const multilevel<D>& m, int k, int nc, F&& f)
-{
-    const std::vector<double> nodes = m.latticeNodes(k);
-    std::vector<double> t;
-    for (std::size_t i = 0; i < nodes.size(); i += D)
-        for (int c = 0; c < nc; ++c) t.push_back(f(&nodes[i], c));
-    return t;
-}
-
 /// An affine field's coefficients: the B-splines reproduce it exactly, so
 /// with it as the trend no level is needed, and the evaluation is the field
 template <int D>

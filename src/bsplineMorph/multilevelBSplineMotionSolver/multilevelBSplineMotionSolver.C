@@ -96,11 +96,9 @@ namespace Foam
             mba::multilevel<D> plan_;
 
             //- initialApproximation thinPlateSpline: the spline (else
-            //  null), the level whose nodes sample it, the nodes and the
-            //  samples
+            //  null), the level whose nodes sample it and the samples
             std::unique_ptr<rbf::thinPlateTrend<D>> trend_;
             const int trendLevel_;
-            const std::vector<double> trendNodes_;
             std::vector<double> trendValues_;
 
             //- Whether a fit that stopped above its threshold was reported
@@ -132,14 +130,11 @@ namespace Foam
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                     bc.mask(), mba::pointsView<D>(evalXyz, nEval), std::move(evalRead)
                 ),
-                trendLevel_(trendGrid > 0 ? trendLevel : -1),
-                trendNodes_
-                (
-                    trendGrid > 0 ? plan_.latticeNodes(trendLevel) : std::vector<double>()
-                )
+                trendLevel_(trendGrid > 0 ? trendLevel : -1)
             {
                 if (trendGrid > 0)
                 {
+                    const std::vector<double> nodes = plan_.latticeNodes(trendLevel);
                     // (the grid over the lattice domain, which every rank shares)
                     const mba::domain<D>& dom = plan_.dom();
                     mba::box<D> b;
@@ -155,7 +150,7 @@ namespace Foam
                             comm, D,
                             mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                             bc.mask(), bc.addedControls(), b, trendGrid,
-                            mba::pointsView<D>(trendNodes_.data(), trendNodes_.size()/D)
+                            mba::pointsView<D>(nodes.data(), nodes.size()/D)
                         )
                     );
                     Info<< multilevelBSplineMotionSolver::typeName
@@ -163,7 +158,7 @@ namespace Foam
                         << " centres (grid " << trendGrid << ", "
                         << trend_->systems() << " system"
                         << (trend_->systems() == 1 ? "" : "s")
-                        << "), sampled at the " << trendNodes_.size()/D
+                        << "), sampled at the " << nodes.size()/D
                         << " nodes of level " << trendLevel << endl;
                 }
             }
