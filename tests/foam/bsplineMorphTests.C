@@ -490,7 +490,7 @@ TEST_CASE("rigidLayers: bad input names the entry and the valid choices", "[foam
     CHECK_THAT
     (
         errorOf("rigidLayers { patches (walls); innerDistance 0.2; outerDistance 0.2; }"),
-        Contains("outerDistance") && Contains("innerDistance")
+        Contains("outerDistance 0.2 must be larger than innerDistance 0.2")
     );
     CHECK_THAT
     (

@@ -61,6 +61,23 @@ namespace
 
 // * * * * * * * * * * * * * * * Global Functions  * * * * * * * * * * * * * //
 
+Foam::word Foam::coeffsInput::nearest(const word& key, const wordList& known)
+{
+    word best;
+    std::size_t fewest = std::string::npos;
+    for (const word& k : known)
+    {
+        const std::size_t e = editDistance(key, k);
+        if (e < fewest)
+        {
+            fewest = e;
+            best = k;
+        }
+    }
+    return fewest <= std::max<std::size_t>(1, best.size()/3) ? best : word::null;
+}
+
+
 void Foam::coeffsInput::warnUnknown
 (
     const dictionary& dict,
@@ -73,23 +90,11 @@ void Foam::coeffsInput::warnUnknown
         {
             continue;
         }
-        // The nearest known keyword, when it is near (at most a third of
-        // its letters, and at least one, changed)
-        word nearest;
-        std::size_t best = std::string::npos;
-        for (const word& k : known)
-        {
-            const std::size_t e = editDistance(key, k);
-            if (e < best)
-            {
-                best = e;
-                nearest = k;
-            }
-        }
+        const word near(nearest(key, known));
         OStringStream hint;
-        if (best <= std::max<std::size_t>(1, nearest.size()/3))
+        if (!near.empty())
         {
-            hint<< " (did you mean '" << nearest << "'?)";
+            hint<< " (did you mean '" << near << "'?)";
         }
         OStringStream names;
         for (const word& k : known)

@@ -333,13 +333,11 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     trendGrid_ = 0;
     if (start == initialApproximation::thinPlateSpline)
     {
-        const dictionary& tps = dict.optionalSubDict("thinPlateSplineCoeffs");
+        // (its entries only: none falls back to the enclosing dictionary)
+        const dictionary tps(dict.subOrEmptyDict("thinPlateSplineCoeffs"));
         trendGrid_ = coeffsInput::getInRange<label>(tps, "grid", 8, 1, 32);
         trendLevel_ = coeffsInput::getInRange<label>(tps, "level", 4, 0, 5);
-        if (&tps != &dict)
-        {
-            coeffsInput::warnUnknown(tps, {"grid", "level"});
-        }
+        coeffsInput::warnUnknown(tps, {"grid", "level"});
     }
     else if (dict.found("thinPlateSplineCoeffs"))
     {

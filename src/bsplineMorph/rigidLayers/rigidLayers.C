@@ -133,10 +133,13 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     outerDistance_ = coeffsInput::getRequiredInRange<scalar>(dict, "outerDistance", 0);
     if (!(outerDistance_ > innerDistance_))
     {
-        FatalIOErrorInFunction(dict)
-            << "outerDistance " << outerDistance_ << " must be larger than"
+        // (the message in a stream of the log's precision)
+        const logPrecision digits;
+        OStringStream msg;
+        msg << "outerDistance " << outerDistance_ << " must be larger than"
             << " innerDistance " << innerDistance_ << " (the blend lies between"
-            << " them)" << exit(FatalIOError);
+            << " them)";
+        FatalIOErrorInFunction(dict) << msg.str().c_str() << exit(FatalIOError);
     }
 }
 

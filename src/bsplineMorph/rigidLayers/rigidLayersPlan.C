@@ -441,6 +441,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
     const boolList owned(ownedPoints(mesh_));
     bitSet inner(mesh_.nPoints());
     markRigid(inner);
+    const label sweeps = nSweeps(nSmooth_, smoothCoeffs_);
     Info<< "rigidLayers: " << nOwnedGlobal(owned, zonePoints_)
         << " points within outerDistance " << outerDistance_ << " of "
         << nOwnedGlobal(owned, wallPoints_) << " wall points on patches "
@@ -450,11 +451,11 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << nOwnedGlobal(owned, shellPoints_)
         << " of them outermost: control points, and "
         << nOwnedGlobal(owned, labelList(UIndirectList<label>(zonePoints_, patchShell_)))
-        << " more on patches, control points where their conditions slide them"
-        << " and their foot is prescribed; rotations smoothed over "
-        << nSmooth_ << " rings of faces, in "
-        << nSweeps(nSmooth_, smoothCoeffs_)
-        << " sweeps)" << endl;
+        << " more on patches (outermost too; control points only where their"
+        << " conditions slide them and their foot is prescribed); rotations"
+        << " smoothed over " << nSmooth_
+        << (nSmooth_ == 1 ? " ring" : " rings") << " of faces, in " << sweeps
+        << (sweeps == 1 ? " sweep)" : " sweeps)") << endl;
 }
 
 
