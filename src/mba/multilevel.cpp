@@ -100,15 +100,12 @@ void multilevel<D>::state::checkInput() const
     });
 }
 
-/// The domain: the global bounding box of the active control points and
-/// the evaluation points (or the given bounds, which must contain it),
-/// padded. Collective.
+namespace {
+
+/// The bounding box of every rank's b. Collective.
 template <int D>
-void multilevel<D>::state::findDomain(const box<D>* bounds)
+box<D> boxOfAllRanks(const communicator& comm, box<D> b)
 {
-    box<D> b = box<D>::empty();
-    for (std::size_t i = 0; i < ctrl.x.size; ++i) if (ctrl.active[i]) b.add(ctrl.x[i]);
-    for (std::size_t i = 0; i < eval.x.size; ++i) b.add(eval.x[i]);
     std::vector<double> mm(2*D);
     for (int d = 0; d < D; ++d) { mm[d] = b.lo[d]; mm[D + d] = -b.hi[d]; }
     const std::vector<double> g = comm.allGatherFixed(mm);
@@ -118,6 +115,21 @@ void multilevel<D>::state::findDomain(const box<D>* bounds)
             b.lo[d] = std::min(b.lo[d], g[at + d]);
             b.hi[d] = std::max(b.hi[d], -g[at + D + d]);
         }
+    return b;
+}
+
+} // namespace
+
+/// The domain: the global bounding box of the active control points and
+/// the evaluation points (or the given bounds, which must contain it),
+/// padded. Collective.
+template <int D>
+void multilevel<D>::state::findDomain(const box<D>* bounds)
+{
+    box<D> b = box<D>::empty();
+    for (std::size_t i = 0; i < ctrl.x.size; ++i) if (ctrl.active[i]) b.add(ctrl.x[i]);
+    for (std::size_t i = 0; i < eval.x.size; ++i) b.add(eval.x[i]);
+    b = boxOfAllRanks(comm, b);
     if (bounds)
     {
         collectively(comm, [&] {
@@ -156,11 +168,19 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
     s.eval.arrange(s.dom);
     if (s.parameters.affine)
     {
+        // Centred on the active control points' bounding box (of all ranks:
+        // the same on any decomposition): where they leave a direction
+        // undetermined (all in a plane, on a line, one point), the minimum-
+        // norm fit then has no gradient along it, and a translation of them
+        // translates the mesh
+        box<D> b = box<D>::empty();
+        for (std::size_t i = 0; i < s.ctrl.x.size; ++i) if (s.ctrl.active[i]) b.add(s.ctrl.x[i]);
+        b = boxOfAllRanks(comm, b);
         point<D> centre;
         double ext = 0;
         for (int d = 0; d < D; ++d)
         {
-            centre[d] = s.dom.lo[d] + 0.5*s.dom.n0[d]*s.dom.h0;
+            centre[d] = b.isEmpty() ? s.dom.lo[d] + 0.5*s.dom.n0[d]*s.dom.h0 : 0.5*(b.lo[d] + b.hi[d]);
             ext = std::max(ext, s.dom.n0[d]*s.dom.h0);
         }
         s.affine = affineFit<D>(comm, nComponents, control, s.ctrl.mask, centre, 0.5*ext);

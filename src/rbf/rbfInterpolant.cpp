@@ -198,6 +198,22 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
             for (int d = 0; d < D; ++d) A(m + 1 + d, j) = A(j, m + 1 + d) = (xj[d] - lo_[d])/scale_;
         }
     }
+    // A coordinate that no centre varies in (the control points all in one
+    // plane or on one line along the axes: a box face) leaves its polynomial
+    // term undetermined: its row and column keep 1 on the diagonal alone, a
+    // zero coefficient
+    for (int d = 0; np && m > 0 && d < D; ++d)
+    {
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
+        for (long j = 0; j < m; ++j)
+        {
+            lo = std::min(lo, x_[centres[j]][d]);
+            hi = std::max(hi, x_[centres[j]][d]);
+        }
+        if (hi - lo > 1e-12*scale_) continue;
+        for (long j = 0; j < m; ++j) A(m + 1 + d, j) = A(j, m + 1 + d) = 0;
+        A(m + 1 + d, m + 1 + d) = 1;
+    }
     double anorm = 0;
     for (long j = 0; j < n; ++j)
     {
@@ -225,7 +241,9 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
         msg << "rbf: the " << n << "x" << n << " " << kernelName(p_.function)
             << " system is singular or ill-conditioned (reciprocal condition " << rcond
             << " < minRcond " << p_.minRcond << "): duplicate or nearly coincident control"
-            " points, or shapeParameter / supportRadius far too large for the point spacing";
+            " points, control points all in one plane or on one line oblique to the axes (the"
+            " linear polynomial needs them to span the mesh's dimensions), or shapeParameter /"
+            " supportRadius far too large for the point spacing";
         precondition(info == 0 && rcond >= p_.minRcond, msg.str());
     });
 }

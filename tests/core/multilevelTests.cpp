@@ -564,6 +564,25 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
         m.evaluate(out);
         for (std::size_t i = 0; i < out.size(); ++i) REQUIRE_THAT(out[i], Catch::WithinAbs(v[i], 1e-6*maxAbs(v)));
     }
+    SECTION("control points on one plane, translated: the whole domain translates")
+    {
+        // (the affine start about the control points' centre leaves no
+        // gradient across the plane; the levels then have nothing to fit)
+        auto c = randomPoints<3>(200, 64);
+        for (auto& x : c) x[2] = 0.1;
+        std::vector<double> v;
+        for (std::size_t i = 0; i < c.size(); ++i) { v.push_back(0.1); v.push_back(-0.05); v.push_back(0.02); }
+        multilevel<3> m(serial(), p, 3, c, {}, e);
+        m.fit(v);
+        std::vector<double> out;
+        m.evaluate(out);
+        for (std::size_t i = 0; i < e.size(); ++i)
+        {
+            REQUIRE_THAT(out[3*i], Catch::WithinAbs(0.1, 1e-12));
+            REQUIRE_THAT(out[3*i + 1], Catch::WithinAbs(-0.05, 1e-12));
+            REQUIRE_THAT(out[3*i + 2], Catch::WithinAbs(0.02, 1e-12));
+        }
+    }
     SECTION("collinear control points, affine start")
     {
         std::vector<point<3>> c;

@@ -28,6 +28,7 @@ Description
 #include "emptyPointPatch.H"
 #include "OStringStream.H"
 #include "HashOps.H"
+#include "unitConversion.H"
 
 #include <cmath>
 
@@ -94,6 +95,10 @@ void Foam::boundaryConstraints::readFixedPatch
     // its vertices given to 8 digits, meet in an axis 7e-9 rad off x)
     const bool twoD = frame.size() < 3;
     const scalar outOfPlane = 1e-10*pMesh_().bounds().mag();
+    // Values over 1e8 times the mesh's size are no mesh motion (the points
+    // would keep a few digits of their cells; near 1e150 their squares
+    // overflow): refused with the non-finite ones
+    const scalar huge = 1e8*pMesh_().bounds().mag();
     forAll(meshPoints, i)
     {
         const label pointi = meshPoints[i];
@@ -101,7 +106,10 @@ void Foam::boundaryConstraints::readFixedPatch
         value_[pointi] = values[i];
         for (direction c = 0; c < 3; ++c)
         {
-            if (!std::isfinite(values[i][c])) nonFinite.insert(pp.name());
+            if (!std::isfinite(values[i][c]) || mag(values[i][c]) > huge)
+            {
+                nonFinite.insert(pp.name());
+            }
         }
         if (twoD)
         {
@@ -153,6 +161,11 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
                 applyNormal(meshPoints[lp], nf[facei]);
             }
         }
+        if (!checkedCurved_.found(patch.name()))
+        {
+            checkedCurved_.insert(patch.name());
+            warnCurved(patch);
+        }
     }
     else if (pf.type() == "fixedNormalSlip")
     {
@@ -189,6 +202,41 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
 }
 
 
+void Foam::boundaryConstraints::warnCurved(const polyPatch& patch)
+{
+    // Points where the patch bends smoothly: its faces there not all
+    // parallel, as pointConstraint tells planes apart (|n1 ^ n2| > 1e-3),
+    // but within 30 deg of each other (not an edge or a corner)
+    const vectorField& nf = patch.faceNormals();
+    const scalar smooth = std::cos(degToRad(30.0));
+    label bent = 0;
+    for (const labelList& faces : patch.pointFaces())
+    {
+        bool parallel = true, sharp = false;
+        for (const label facei : faces)
+        {
+            parallel = parallel && mag(nf[facei] ^ nf[faces[0]]) <= 1e-3;
+            sharp = sharp || (nf[facei] & nf[faces[0]]) < smooth;
+        }
+        bent += !parallel && !sharp;
+    }
+    const label n = returnReduce(patch.nPoints(), sumOp<label>());
+    reduce(bent, sumOp<label>());
+    if (2*bent > n)
+    {
+        WarningInFunction
+            << "Patch " << patch.name() << " slides its points (slip or"
+            << " symmetry), but it bends at " << bent << " of its " << n
+            << " points (its faces there within 30 deg of each other but not"
+            << " coplanar; counted on each rank that holds them): a curved"
+            << " wall. Those points are held on the lines where their faces"
+            << " meet, or fixed where three or more do, not slid along the"
+            << " wall: the morph slides points on flat parts of such patches"
+            << " only" << endl;
+    }
+}
+
+
 void Foam::boundaryConstraints::checkPrescribed
 (
     wordHashSet& nonFinite,
@@ -204,7 +252,8 @@ void Foam::boundaryConstraints::checkPrescribed
     if (nonFinite.size())
     {
         FatalErrorInFunction
-            << "pointDisplacement has non-finite (NaN or Inf) values on patches "
+            << "pointDisplacement has non-finite (NaN or Inf) or huge (over 1e8"
+            << " times the mesh's bounding-box diagonal) values on patches "
             << flatOutput(nonFinite.sortedToc()) << " at time "
             << mesh.time().timeName() << "; the mesh is not moved"
             << exit(FatalError);

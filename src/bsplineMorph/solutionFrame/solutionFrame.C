@@ -17,6 +17,8 @@ License
 
 #include "solutionFrame.H"
 #include "wedgePolyPatch.H"
+#include "emptyPolyPatch.H"
+#include "bitSet.H"
 #include "DynamicList.H"
 #include "SubField.H"
 
@@ -37,6 +39,39 @@ namespace
             if (mag(v[c]) > mag(v[big])) big = c;
         }
         return v[big] < 0 ? -v : v;
+    }
+}
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+void Foam::solutionFrame::checkOneCellThick(const polyMesh& mesh)
+{
+    // Every point of a 2D mesh lies on its empty patches (one cell between
+    // them): otherwise the points between them would be morphed in the plane
+    // alone, and OpenFOAM's twoDPointCorrector would move them onto the
+    // empty planes
+    bitSet onEmpty(mesh.nPoints());
+    wordList names;
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        if (isA<emptyPolyPatch>(pp))
+        {
+            onEmpty.set(pp.meshPoints());
+            names.append(pp.name());
+        }
+    }
+    const label off = returnReduce(mesh.nPoints() - label(onEmpty.count()), sumOp<label>());
+    if (off > 0)
+    {
+        FatalErrorInFunction
+            << "The mesh is 2D (empty patches " << flatOutput(names) << ") but "
+            << off << " of its " << returnReduce(mesh.nPoints(), sumOp<label>())
+            << " points (counted on each rank that holds them) lie on no"
+            << " empty patch: a 2D mesh is one cell thick between its empty"
+            << " patches. Make the mesh one cell thick, or give these patches"
+            << " another type (e.g. symmetryPlane) for a 3D morph"
+            << exit(FatalError);
     }
 }
 
@@ -95,6 +130,10 @@ Foam::solutionFrame::solutionFrame
             {
                 directions_.append(d);
             }
+        }
+        if (directions_.size() < 3)
+        {
+            checkOneCellThick(mesh);
         }
         return;
     }
