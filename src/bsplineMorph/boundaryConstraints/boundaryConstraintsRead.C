@@ -150,21 +150,26 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         // line, fixed): a patch spanning several planes (the faces of a box)
         // constrains its edge points to the line where they meet. Averaged
         // point normals would not: they tilt at edges and differ between the
-        // ranks that share a point.
+        // ranks that share a point. Where the patch bends smoothly (a curved
+        // wall), the mean of its faces' normals at the point, summed over the
+        // ranks that hold it: the point slides in that plane, as OpenFOAM's
+        // slip slides along point normals (leaving a wall of radius R by
+        // about d^2/2R for a slide d)
         const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
         const vectorField& nf = patch.faceNormals();
-        const faceList& lf = patch.localFaces();
-        forAll(lf, facei)
+        const labelListList& pointFaces = patch.pointFaces();
+        const vectorField mean(curvedSlip(patch));
+        forAll(pointFaces, lp)
         {
-            for (const label lp : lf[facei])
+            if (mean.size() && mean[lp] != vector::zero)
+            {
+                applyNormal(meshPoints[lp], mean[lp]);
+                continue;
+            }
+            for (const label facei : pointFaces[lp])
             {
                 applyNormal(meshPoints[lp], nf[facei]);
             }
-        }
-        if (!checkedCurved_.found(patch.name()))
-        {
-            checkedCurved_.insert(patch.name());
-            warnCurved(patch);
         }
     }
     else if (pf.type() == "fixedNormalSlip")
@@ -202,38 +207,52 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
 }
 
 
-void Foam::boundaryConstraints::warnCurved(const polyPatch& patch)
+Foam::vectorField Foam::boundaryConstraints::curvedSlip(const polyPatch& patch)
 {
-    // Points where the patch bends smoothly: its faces there not all
-    // parallel, as pointConstraint tells planes apart (|n1 ^ n2| > 1e-3),
-    // but within 30 deg of each other (not an edge or a corner)
+    const bool first = !slipShared_.found(patch.name());
+    if (!first && !slipShared_[patch.name()])
+    {
+        return vectorField();
+    }
+    std::shared_ptr<const sharedPoints> shared =
+        first
+      ? std::make_shared<const sharedPoints>(pMesh_(), patch.meshPoints())
+      : slipShared_[patch.name()];
     const vectorField& nf = patch.faceNormals();
-    const scalar smooth = std::cos(degToRad(30.0));
-    label bent = 0;
-    for (const labelList& faces : patch.pointFaces())
+    const labelListList& pointFaces = patch.pointFaces();
+    List<vector> sum(patch.nPoints(), Zero);
+    List<scalar> count(patch.nPoints(), Zero);
+    forAll(pointFaces, lp)
     {
-        bool parallel = true, sharp = false;
-        for (const label facei : faces)
+        for (const label facei : pointFaces[lp])
         {
-            parallel = parallel && mag(nf[facei] ^ nf[faces[0]]) <= 1e-3;
-            sharp = sharp || (nf[facei] & nf[faces[0]]) < smooth;
+            sum[lp] += nf[facei];
+            count[lp] += 1;
         }
-        bent += !parallel && !sharp;
     }
-    const label n = returnReduce(patch.nPoints(), sumOp<label>());
-    reduce(bent, sumOp<label>());
-    if (2*bent > n)
+    shared->sum(sum);
+    shared->sum(count);
+    // Bent smoothly: |sum| of unit normals within (cos 30 deg, 1) of their
+    // count (two faces: within 60 deg of each other; coplanar ones to
+    // rounding, 1e-9, keep their own normals)
+    const scalar smooth = std::cos(degToRad(30.0));
+    vectorField mean(patch.nPoints(), Zero);
+    bool bent = false;
+    forAll(sum, lp)
     {
-        WarningInFunction
-            << "Patch " << patch.name() << " slides its points (slip or"
-            << " symmetry), but it bends at " << bent << " of its " << n
-            << " points (its faces there within 30 deg of each other but not"
-            << " coplanar; counted on each rank that holds them): a curved"
-            << " wall. Those points are held on the lines where their faces"
-            << " meet, or fixed where three or more do, not slid along the"
-            << " wall: the morph slides points on flat parts of such patches"
-            << " only" << endl;
+        const scalar m = mag(sum[lp]);
+        if (m >= smooth*count[lp] && m < (1 - 1e-9)*count[lp])
+        {
+            mean[lp] = sum[lp]/m;
+            bent = true;
+        }
     }
+    if (first)
+    {
+        reduce(bent, orOp<bool>());
+        slipShared_.insert(patch.name(), bent ? shared : nullptr);
+    }
+    return mean;
 }
 
 
