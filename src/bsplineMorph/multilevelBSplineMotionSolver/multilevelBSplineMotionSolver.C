@@ -102,7 +102,8 @@ namespace Foam
             std::vector<double> trendValues_;
 
             //- Whether a fit that stopped above its threshold was reported
-            bool warned_ = false;
+            //  (the solver's flag: once a run)
+            bool& warned_;
 
         public:
 
@@ -120,7 +121,8 @@ namespace Foam
                 const std::size_t nEval,
                 std::vector<std::uint8_t> evalRead,
                 const label trendGrid,
-                const label trendLevel
+                const label trendLevel,
+                bool& warned
             )
             :
                 controlXyz_(controlCoordinates(bc, points0)),
@@ -130,7 +132,8 @@ namespace Foam
                     mba::pointsView<D>(controlXyz_.data(), bc.controlPoints().size()),
                     bc.mask(), mba::pointsView<D>(evalXyz, nEval), std::move(evalRead)
                 ),
-                trendLevel_(trendGrid > 0 ? trendLevel : -1)
+                trendLevel_(trendGrid > 0 ? trendLevel : -1),
+                warned_(warned)
             {
                 if (trendGrid > 0)
                 {
@@ -421,12 +424,14 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
+                 warnedNotReached_));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_));
+                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
+                 warnedNotReached_));
         }
         else
         {
