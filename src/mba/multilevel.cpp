@@ -66,7 +66,7 @@ struct multilevel<D>::state
     {}
 
     void checkInput() const;
-    void findDomain(const box<D>* bounds);
+    box<D> findDomain(const box<D>* bounds);
     double checkValues(const std::vector<double>& values) const;
     void setTrend(int k, const std::vector<double>& coefficients);
     void startResiduals(const std::vector<double>& values);
@@ -102,44 +102,51 @@ void multilevel<D>::state::checkInput() const
 
 namespace {
 
-/// The bounding box of every rank's b. Collective.
+/// Each of boxes made the bounding box of that box of every rank (one
+/// all-gather). Collective.
 template <int D>
-box<D> boxOfAllRanks(const communicator& comm, box<D> b)
+void boxesOfAllRanks(const communicator& comm, std::vector<box<D>>& boxes)
 {
-    std::vector<double> mm(2*D);
-    for (int d = 0; d < D; ++d) { mm[d] = b.lo[d]; mm[D + d] = -b.hi[d]; }
+    const std::size_t n = boxes.size();
+    std::vector<double> mm(2*D*n);
+    for (std::size_t k = 0; k < n; ++k)
+        for (int d = 0; d < D; ++d) { mm[2*D*k + d] = boxes[k].lo[d]; mm[2*D*k + D + d] = -boxes[k].hi[d]; }
     const std::vector<double> g = comm.allGatherFixed(mm);
-    for (std::size_t at = 0; at < g.size(); at += 2*D)
-        for (int d = 0; d < D; ++d)
-        {
-            b.lo[d] = std::min(b.lo[d], g[at + d]);
-            b.hi[d] = std::max(b.hi[d], -g[at + D + d]);
-        }
-    return b;
+    for (std::size_t at = 0; at < g.size(); at += 2*D*n)
+        for (std::size_t k = 0; k < n; ++k)
+            for (int d = 0; d < D; ++d)
+            {
+                boxes[k].lo[d] = std::min(boxes[k].lo[d], g[at + 2*D*k + d]);
+                boxes[k].hi[d] = std::max(boxes[k].hi[d], -g[at + 2*D*k + D + d]);
+            }
 }
 
 } // namespace
 
 /// The domain: the global bounding box of the active control points and
 /// the evaluation points (or the given bounds, which must contain it),
-/// padded. Collective.
+/// padded. Returns the active control points' global bounding box.
+/// Collective.
 template <int D>
-void multilevel<D>::state::findDomain(const box<D>* bounds)
+box<D> multilevel<D>::state::findDomain(const box<D>* bounds)
 {
-    box<D> b = box<D>::empty();
-    for (std::size_t i = 0; i < ctrl.x.size; ++i) if (ctrl.active[i]) b.add(ctrl.x[i]);
-    for (std::size_t i = 0; i < eval.x.size; ++i) b.add(eval.x[i]);
-    b = boxOfAllRanks(comm, b);
+    std::vector<box<D>> b(2, box<D>::empty());    // control, evaluation points
+    for (std::size_t i = 0; i < ctrl.x.size; ++i) if (ctrl.active[i]) b[0].add(ctrl.x[i]);
+    for (std::size_t i = 0; i < eval.x.size; ++i) b[1].add(eval.x[i]);
+    boxesOfAllRanks(comm, b);
+    box<D> all = b[0];
+    all.add(b[1]);
     if (bounds)
     {
         collectively(comm, [&] {
             for (int d = 0; d < D; ++d)
-                precondition(b.isEmpty() || (bounds->lo[d] <= b.lo[d] && b.hi[d] <= bounds->hi[d]),
+                precondition(all.isEmpty() || (bounds->lo[d] <= all.lo[d] && all.hi[d] <= bounds->hi[d]),
                     "mba: the given bounds do not contain all points");
         });
-        b = *bounds;
+        all = *bounds;
     }
-    collectively(comm, [&] { dom = domain<D>::fromBox(b, parameters.initialGrid, parameters.padding); });
+    collectively(comm, [&] { dom = domain<D>::fromBox(all, parameters.initialGrid, parameters.padding); });
+    return b[0];
 }
 
 template <int D>
@@ -161,7 +168,7 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
     state& s = self();
     s.checkInput();
     s.ctrl.classify(comm);
-    s.findDomain(bounds);
+    const box<D> controlBox = s.findDomain(bounds);
     precondition(s.ctrl.x.size < (std::size_t(1) << 32) && s.eval.x.size < (std::size_t(1) << 32),
         "mba: at most 2^32 points per rank");
     s.ctrl.arrange(s.dom);
@@ -173,9 +180,7 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
         // undetermined (all in a plane, on a line, one point), the minimum-
         // norm fit then has no gradient along it, and a translation of them
         // translates the mesh
-        box<D> b = box<D>::empty();
-        for (std::size_t i = 0; i < s.ctrl.x.size; ++i) if (s.ctrl.active[i]) b.add(s.ctrl.x[i]);
-        b = boxOfAllRanks(comm, b);
+        const box<D>& b = controlBox;
         point<D> centre;
         double ext = 0;
         for (int d = 0; d < D; ++d)
