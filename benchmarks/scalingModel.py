@@ -2,6 +2,7 @@
 
     /usr/bin/python3 benchmarks/scalingModel.py RECORDS... [--real REAL] [--plot PNG] [--table]
     /usr/bin/python3 benchmarks/scalingModel.py --traffic RECORDS...
+    /usr/bin/python3 benchmarks/scalingModel.py --exchanges RECORDS...
 
 RECORDS are files with mbaScaling's RESULT lines (benchmarks/scaling writes
 them): per rank count and decomposition, the busiest rank's work (thread CPU
@@ -54,6 +55,12 @@ and network.
 what the busiest rank receives (against its share of the boundary, 48 bytes
 per control point, and against the least possible, mbaScaling --lower-bound),
 its messages (also per neighbour and level), its work and the imbalance.
+--exchanges: a markdown table of the same cases run with each of mbaScaling's
+--exchange choices (benchmarks/scaling --exchanges writes them): per case and
+choice the rounds, what the busiest rank receives, the model's cost of the
+levels' exchange per step (R alpha + M o + B / beta) on both networks, and
+beside it that of the step's all-gathers and reductions, which every choice
+has.
 """
 import math
 import sys
@@ -62,6 +69,8 @@ from collections import defaultdict
 # the decompositions as the tables name them, in the order they list them
 NAMES = {"simple": "slabs", "hierarchical": "boxes", "columns": "columns"}
 ORDER = {"simple": 0, "hierarchical": 1, "columns": 2}
+# mbaScaling's --exchange choices, in the order the tables list them
+EXCHANGES = ["direct", "chunked", "tree", "automatic"]
 
 # The motion solver's reductions a step outside the core (interpolatingMotionSolver
 # with multilevelBSpline, a 3D case without rigid layers; see the header)
@@ -77,8 +86,8 @@ NETWORKS = {
 def read_records(paths):
     """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines; a
     rank count recorded more than once counts by its record of median work
-    (benchmarks/scaling measures one rank three times: every efficiency's
-    baseline)"""
+    (benchmarks/scaling measures one rank three times per decomposition: every
+    efficiency's baseline, the median of all one-rank runs of the size)"""
     runs = defaultdict(lambda: defaultdict(list))
     for path in paths:
         with open(path) as f:
@@ -93,11 +102,16 @@ def read_records(paths):
                     except ValueError:
                         rec[k] = v
                 runs[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])].append(rec)
+    # one rank is the same computation whatever the decomposition: its runs
+    # at a size are pooled (benchmarks/scaling's three per decomposition)
+    single = defaultdict(list)
+    for (n, d), byRanks in runs.items():
+        single[n] += byRanks.get(1, [])
     out = defaultdict(dict)
     for key, byRanks in runs.items():
         for P, recs in byRanks.items():
-            recs = sorted(recs, key=lambda r: r["work_max"])
-            out[key][P] = recs[(len(recs) - 1)//2]
+            recs = sorted(single[key[0]] if P == 1 else recs, key=lambda r: r["work_max"])
+            out[key][P] = dict(recs[(len(recs) - 1)//2], decomposition=key[1])
     return out
 
 
@@ -174,6 +188,33 @@ def traffic_table(records):
                 r["work_max"]/r["work_mean"]))
 
 
+def exchanges_table(paths):
+    """Markdown: per size, decomposition and rank count, each --exchange choice's traffic and modelled cost"""
+    rows = {}
+    for path in paths:
+        with open(path) as f:
+            for line in f:
+                if line.startswith("RESULT "):
+                    rec = dict(kv.split("=", 1) for kv in line.split()[1:])
+                    rec = {k: (float(v) if k not in ("decomposition", "exchange", "parts") else v)
+                           for k, v in rec.items() if k not in ("assignment", "work_measured")}
+                    rows[(int(rec["n"]), ORDER.get(rec["decomposition"], 3), int(rec["ranks"]),
+                          EXCHANGES.index(rec["exchange"]))] = rec
+    print("| cells | decomposition | ranks | exchange | rounds | max messages | max bytes received | / share "
+          "| exchange s, infiniband | exchange s, ethernet25 | all-gathers and reductions s, infiniband |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for key in sorted(rows):
+        r = rows[key]
+        P = key[2]
+        # T(P)'s terms: the levels' exchange, and the collectives that every choice has
+        coll = lambda net: (r["all_gathers"] + SOLVER_REDUCTIONS)*2*math.ceil(math.log2(P))*NETWORKS[net]["alpha"]
+        exch = lambda net: step_time(r, P, NETWORKS[net]) - r["work_max"] - coll(net)
+        print("| %.3gM | %s | %d | %s | %d | %d | %d | %.2f | %.5f | %.5f | %.5f |" % (
+            key[0]**3/1e6, NAMES.get(r["decomposition"], r["decomposition"]), P, r["exchange"], r["exchanges"],
+            r["messages_max"], r["recv_bytes_max"], r["recv_bytes_max"]/r["share_bytes"],
+            exch("infiniband"), exch("ethernet25"), coll("infiniband")))
+
+
 def main(argv):
     paths, real, plot, table = [], None, None, False
     i = 0
@@ -187,6 +228,9 @@ def main(argv):
             table = True; i += 1; continue
         if a == "--traffic":
             traffic_table(read_records(argv[i + 1:]))
+            return
+        if a == "--exchanges":
+            exchanges_table(argv[i + 1:])
             return
         paths.append(a); i += 1
     if not paths:

@@ -84,6 +84,7 @@ struct options
     bool lowerBound = false;
     int steps = 1;
     params::exchangeMode exchange = params::exchangeMode::automatic;
+    std::string exchangeName = "automatic";   ///< as given, for the RESULT line
     bool balanced = false;   ///< --control balanced
     bool replay = false;     ///< --replay
 };
@@ -147,6 +148,7 @@ options parse(int argc, char** argv)
             else if (a == "--exchange")
             {
                 const std::string e = val();
+                o.exchangeName = e;
                 if (e == "automatic") o.exchange = params::exchangeMode::automatic;
                 else if (e == "direct") o.exchange = params::exchangeMode::direct;
                 else if (e == "chunked") o.exchange = params::exchangeMode::chunked;
@@ -535,14 +537,14 @@ int main(int argc, char** argv)
             std::printf("%5d %9s %8.0f %8.0f %11.0f %11.0f %8.2f %6.0f %6.1f %5d %9.4f %9.4f %9.4f %9.4f %8.2f\n",
                         P, pstr.c_str(), ctrl.max, nb.max, bytes.max, bytes.mean, bytes.max/share, msgs.max,
                         msgs.mean, res.levels, fit.max, fit.mean, ev.max, ev.mean, work.max/work.mean);
-            std::printf("RESULT n=%ld decomposition=%s assignment=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
+            std::printf("RESULT n=%ld decomposition=%s exchange=%s assignment=%s ranks=%d parts=%s levels=%d control=%ld ctrl_max=%.0f "
                         "ctrl_mean=%.1f eval_max=%.0f eval_mean=%.1f neighbours_max=%.0f recv_bytes_max=%.0f "
                         "recv_bytes_mean=%.1f share_bytes=%.1f messages_max=%.0f messages_mean=%.2f "
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
                         "plan_cpu_max=%.4f max_residual=%.17g lower_bound_max=%.0f work_measured=%s%s\n",
-                        n, o.decomposition.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
+                        n, o.decomposition.c_str(), o.exchangeName.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
                         res.maxResidual, bound.max, o.replay ? "alone" : "simulated",
