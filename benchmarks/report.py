@@ -104,6 +104,7 @@ def median(v):
     return 0.5 * (v[(len(v) - 1) // 2] + v[len(v) // 2])
 
 def tables(resultsPath, mdPath, imgDir, scaleN, plots):
+    written = []   # the plots saved
     # every trial of a case: its first step, and its later steps pooled
     runs = {}
     for line in open(resultsPath):
@@ -278,6 +279,7 @@ def tables(resultsPath, mdPath, imgDir, scaleN, plots):
         ax[0].set_title("time per step [s] (median)"); ax[1].set_title("peak memory of the run [MB]")
         for a in ax: a.set_xlabel("cells"); a.grid(alpha=0.3, which="both"); a.legend(fontsize=7)
         fig.tight_layout(); fig.savefig(imgDir + "/bench-growth.png", dpi=110)
+        written.append(imgDir + "/bench-growth.png")
     if scal and plots:
         plt = pyplot()
         cores = os.cpu_count() or 1
@@ -303,19 +305,30 @@ def tables(resultsPath, mdPath, imgDir, scaleN, plots):
             l = ax[2].loglog([a for a, b, c in pts], [b for a, b, c in pts], marker="o", label="%d ranks: max received by one rank" % np_)
             ax[2].loglog([a for a, b, c in pts], [c for a, b, c in pts], ":", color=l[0].get_color(), label="%d ranks: a rank's share" % np_)
         ax[2].set_xlabel("cells"); ax[2].set_title("communication per step against mesh size [bytes]", fontsize=9)
-        ax[2].legend(fontsize=7); ax[2].grid(alpha=0.3, which="both")
+        if ax[2].get_legend_handles_labels()[0]:
+            ax[2].legend(fontsize=7)
+        ax[2].grid(alpha=0.3, which="both")
         fig.tight_layout(); fig.savefig(imgDir + "/bench-scaling.png", dpi=110)
+        written.append(imgDir + "/bench-scaling.png")
     open(mdPath, "w").write("\n".join(out) + "\n")
     print("\n".join(out))
+    for path in written:
+        print("wrote " + path)
 
 def main():
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    if sys.argv[1] in ("-h", "--help", "-help"):
+        print(__doc__)
+        return
     mode, args = sys.argv[1], sys.argv[2:]
-    if mode == "record":
+    if mode == "record" and len(args) == 4:
         print(record(*args))
-    elif mode == "tables":
+    elif mode == "tables" and len(args) == 5:
         tables(args[0], args[1], args[2], int(args[3]), args[4] == "1")
     else:
-        sys.exit("report.py: unknown mode %s (record, tables)" % mode)
+        sys.exit("report.py: expected 'record N METHOD RANKS CASE' or 'tables RUNS MD IMAGES SCALEN PLOTS'"
+                 " (--help), got: %s" % " ".join(sys.argv[1:]))
 
 if __name__ == "__main__":
     main()

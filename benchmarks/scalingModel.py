@@ -220,6 +220,11 @@ def main(argv):
     i = 0
     while i < len(argv):
         a = argv[i]
+        if a in ("-h", "--help", "-help"):
+            print(__doc__)
+            return
+        if a in ("--real", "--plot") and i + 1 == len(argv):
+            sys.exit("scalingModel.py: option %s needs a value (--help)" % a)
         if a == "--real":
             real = argv[i + 1]; i += 2; continue
         if a == "--plot":
@@ -232,6 +237,8 @@ def main(argv):
         if a == "--exchanges":
             exchanges_table(argv[i + 1:])
             return
+        if a.startswith("-"):
+            sys.exit("scalingModel.py: unknown option %s (--help: the options)" % a)
         paths.append(a); i += 1
     if not paths:
         sys.exit(__doc__)
