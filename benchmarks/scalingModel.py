@@ -333,7 +333,9 @@ def main(argv):
                     continue
                 P = [r[0] for r in rows]
                 style = "-" if name == "infiniband" else "--"
-                label = "%s, %s" % (NAMES.get(decomposition, decomposition), name)
+                # a decomposition without records of this size is scaled from another size's
+                label = "%s, %s%s" % (NAMES.get(decomposition, decomposition), name,
+                                      "" if (n, decomposition) in records else " (scaled)")
                 a1.loglog(P, [r[2] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3, label=label)
                 a2.semilogx(P, [100*r[3] for r in rows], style, color=colours.get(decomposition), marker="o", ms=3,
                             label=label)
