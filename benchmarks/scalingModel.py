@@ -83,12 +83,8 @@ NETWORKS = {
 }
 
 
-def read_records(paths):
-    """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines; a
-    rank count recorded more than once counts by its record of median work
-    (benchmarks/scaling measures one rank three times per decomposition: every
-    efficiency's baseline, the median of all one-rank runs of the size)"""
-    runs = defaultdict(lambda: defaultdict(list))
+def result_lines(paths):
+    """The RESULT lines of mbaScaling's output files, each as a dict (numbers as floats)"""
     for path in paths:
         with open(path) as f:
             for line in f:
@@ -101,7 +97,17 @@ def read_records(paths):
                         rec[k] = float(v)
                     except ValueError:
                         rec[k] = v
-                runs[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])].append(rec)
+                yield rec
+
+
+def read_records(paths):
+    """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines; a
+    rank count recorded more than once counts by its record of median work
+    (benchmarks/scaling measures one rank three times per decomposition: every
+    efficiency's baseline, the median of all one-rank runs of the size)"""
+    runs = defaultdict(lambda: defaultdict(list))
+    for rec in result_lines(paths):
+        runs[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])].append(rec)
     # one rank is the same computation whatever the decomposition: its runs
     # at a size are pooled (benchmarks/scaling's three per decomposition)
     single = defaultdict(list)
@@ -115,14 +121,19 @@ def read_records(paths):
     return out
 
 
+def comm_times(rec, P, net):
+    """Modelled seconds of the busiest rank's communication a step: the
+    levels' exchange (R alpha + M o + B / beta) and the all-gathers and
+    reductions ((G + S) 2 ceil(log2 P) alpha)"""
+    if P == 1:
+        return 0.0, 0.0
+    return (rec["exchanges"]*net["alpha"] + rec["messages_max"]*net["o"] + rec["recv_bytes_max"]/net["beta"],
+            (rec["all_gathers"] + SOLVER_REDUCTIONS)*2*math.ceil(math.log2(P))*net["alpha"])
+
+
 def step_time(rec, P, net):
     """Modelled seconds of one step of the busiest rank"""
-    work = rec["work_max"]
-    if P == 1:
-        return work
-    comm = (rec["exchanges"]*net["alpha"] + rec["messages_max"]*net["o"] + rec["recv_bytes_max"]/net["beta"]
-            + (rec["all_gathers"] + SOLVER_REDUCTIONS)*2*math.ceil(math.log2(P))*net["alpha"])
-    return work + comm
+    return rec["work_max"] + sum(comm_times(rec, P, net))
 
 
 def scaled(records, n, ranks):
@@ -191,15 +202,9 @@ def traffic_table(records):
 def exchanges_table(paths):
     """Markdown: per size, decomposition and rank count, each --exchange choice's traffic and modelled cost"""
     rows = {}
-    for path in paths:
-        with open(path) as f:
-            for line in f:
-                if line.startswith("RESULT "):
-                    rec = dict(kv.split("=", 1) for kv in line.split()[1:])
-                    rec = {k: (float(v) if k not in ("decomposition", "exchange", "parts") else v)
-                           for k, v in rec.items() if k not in ("assignment", "work_measured")}
-                    rows[(int(rec["n"]), ORDER.get(rec["decomposition"], 3), int(rec["ranks"]),
-                          EXCHANGES.index(rec["exchange"]))] = rec
+    for rec in result_lines(paths):
+        rows[(int(rec["n"]), ORDER.get(rec["decomposition"], 3), int(rec["ranks"]),
+              EXCHANGES.index(rec["exchange"]))] = rec
     print("| cells | decomposition | ranks | exchange | rounds | max messages | max bytes received | / share "
           "| exchange s, infiniband | exchange s, ethernet25 | all-gathers and reductions s, infiniband |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -207,8 +212,8 @@ def exchanges_table(paths):
         r = rows[key]
         P = key[2]
         # T(P)'s terms: the levels' exchange, and the collectives that every choice has
-        coll = lambda net: (r["all_gathers"] + SOLVER_REDUCTIONS)*2*math.ceil(math.log2(P))*NETWORKS[net]["alpha"]
-        exch = lambda net: step_time(r, P, NETWORKS[net]) - r["work_max"] - coll(net)
+        exch = lambda net: comm_times(r, P, NETWORKS[net])[0]
+        coll = lambda net: comm_times(r, P, NETWORKS[net])[1]
         print("| %.3gM | %s | %d | %s | %d | %d | %d | %.2f | %.5f | %.5f | %.5f |" % (
             key[0]**3/1e6, NAMES.get(r["decomposition"], r["decomposition"]), P, r["exchange"], r["exchanges"],
             r["messages_max"], r["recv_bytes_max"], r["recv_bytes_max"]/r["share_bytes"],
