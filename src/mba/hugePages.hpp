@@ -23,6 +23,15 @@ constexpr std::size_t hugePageBytes = std::size_t(2) << 20;
 /// range holds a whole huge page and the kernel took the advice.
 bool adviseHugePages(void* p, std::size_t bytes);
 
+/// Backs the whole 2 MiB pages inside [p, p + bytes) with huge pages now,
+/// also where the memory has been written (its contents kept): the kernel
+/// copies them into huge pages (MADV_COLLAPSE, Linux 6.1 and later), else it
+/// takes the advice for later (MADV_HUGEPAGE). For mesh-sized arrays made by
+/// others (OpenFOAM's fields), once per plan: moving 4 KiB pages costs a few
+/// ms a MiB, pages that are huge already nothing. Returns whether the pages
+/// are huge now.
+bool collapseHugePages(const void* p, std::size_t bytes);
+
 /// Memory for bytes: at least hugePageBytes, a fresh anonymous mapping advised
 /// for huge pages (so never written before); less, operator new. Throws
 /// std::bad_alloc.

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+#include <sys/mman.h>
 
 using namespace mba;
 
@@ -89,4 +91,34 @@ TEST_CASE("Large vectors get huge pages where the kernel offers them", "[core][m
     {
         CHECK(kB == 0);
     }
+}
+
+TEST_CASE("Memory already written moves to huge pages with its values", "[core][memory]")
+{
+    std::vector<double> small(1000, 2.0);
+    CHECK_FALSE(collapseHugePages(small.data(), small.size()*sizeof(double)));
+    CHECK(small[999] == 2.0);
+
+    // 16 MiB of a mapping never advised, written on 4 KiB pages (as an
+    // OpenFOAM field), then collapsed: the same values, and where the kernel
+    // does it (Linux 6.1 on, THP not "never") its aligned interior on huge
+    // pages
+    const std::size_t n = std::size_t(1) << 21, bytes = n*sizeof(double);
+    void* m = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    REQUIRE(m != MAP_FAILED);
+    double* v = static_cast<double*>(m);
+    for (std::size_t i = 0; i < n; ++i) v[i] = 0.5*double(i) - 7.0;
+    const std::string mode = thpMode();
+    const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(v);
+    const void* page = reinterpret_cast<const void*>((a + hugePageBytes - 1) & ~std::uintptr_t(hugePageBytes - 1));
+    if (mode == "madvise" || mode == "never") CHECK(hugeKBAt(page) == 0);
+    const bool collapsed = collapseHugePages(v, bytes);
+    const long kB = hugeKBAt(page);
+    INFO("THP mode '" << mode << "', collapsed " << collapsed << ": " << kB << " kB of huge pages in the mapping");
+    if (collapsed) CHECK(kB >= 2048*7);
+    if (mode == "never") CHECK_FALSE(collapsed);
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < n; ++i) wrong += v[i] != 0.5*double(i) - 7.0;
+    CHECK(wrong == 0);
+    munmap(m, bytes);
 }

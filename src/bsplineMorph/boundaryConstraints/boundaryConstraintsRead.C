@@ -28,6 +28,7 @@ Description
 #include "emptyPointPatch.H"
 #include "OStringStream.H"
 #include "HashOps.H"
+#include "hugePageLists.H"
 #include "unitConversion.H"
 
 #include <cmath>
@@ -42,14 +43,19 @@ void Foam::boundaryConstraints::resetPointArrays()
     labelList& fixed = fixedSync_;
     if (fixed.size() != nPoints)
     {
-        fixed.setSize(nPoints);
+        // (read and reset at the boundary points every step: on huge pages)
+        setSizeOnHugePages(fixed, nPoints);
         fixed = 0;
-        fixed_.setSize(nPoints);
+        setSizeOnHugePages(fixed_, nPoints);
         fixed_ = false;
-        value_.setSize(nPoints);
+        setSizeOnHugePages(value_, nPoints);
         value_ = Zero;
-        slide_.setSize(nPoints);
+        setSizeOnHugePages(slide_, nPoints);
         slide_ = pointConstraint();
+        onHugePages(fixed);
+        onHugePages(fixed_);
+        onHugePages(value_);
+        onHugePages(slide_);
     }
     // (only what the last update set is reset: storing a pointConstraint at
     // every boundary point cost more than the rest of the update together)

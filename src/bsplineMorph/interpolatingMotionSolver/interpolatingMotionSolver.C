@@ -24,7 +24,7 @@ License
 #include "OSspecific.H"
 #include "coeffsInput.H"
 #include "logPrecision.H"
-#include "hugePages.hpp"
+#include "hugePageLists.H"
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
@@ -40,20 +40,6 @@ namespace Foam
             { onInverted::fatal, "fatal" },
             { onInverted::warn, "warn" },
         });
-
-        //- Size a mesh-sized work array swept every step; when it is
-        //  allocated, ask for huge pages before it is first written (as the
-        //  core's arrays; best effort: malloc may hand out memory written
-        //  before, which keeps its pages)
-        template<class T>
-        void setSizeOnHugePages(List<T>& list, const label n)
-        {
-            if (list.size() != n)
-            {
-                list.setSize(n);
-                mba::adviseHugePages(list.data(), n*sizeof(T));
-            }
-        }
 
         bool readInvertedCellsFatal(const dictionary& dict)
         {
@@ -130,6 +116,7 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
         rigidLayersPtr_->markRigid(rigid);
     }
     DynamicList<label> points(fixed.size());
+    adviseHugePages(points);
     forAll(fixed, pointi)
     {
         if (!fixed[pointi] && !(rigid.test(pointi) && !bc.constrains(pointi)))
@@ -144,12 +131,22 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
     evalPoints_.transfer(points);
     const solutionFrame& frame = constraintsPtr_->frame();
     const pointField& p0 = points0();
-    evalXyz_.clear();
-    evalXyz_.reserve(frame.size()*evalPoints_.size());
+    reserveOnHugePages(evalXyz_, frame.size()*evalPoints_.size());
     for (const label pointi : evalPoints_)
     {
         frame.appendCoordinates(p0[pointi], evalXyz_);
     }
+    // The mesh-sized lists that every step sweeps, on huge pages (values_
+    // keeps its storage while its size does; newPoints_ was advised when it
+    // was sized)
+    reserveOnHugePages(values_, evalXyz_.size());
+    values_.assign(evalXyz_.size(), 0);
+    onHugePages(evalXyz_);
+    onHugePages(values_);
+    onHugePages(evalPoints_);
+    onHugePages(p0);
+    onHugePages(pointDisplacement_.primitiveField());
+    onHugePages(newPoints_);
     // The re-fit interpolator evaluates these points too
     refitInterpolatorPtr_.reset();
 }

@@ -18,6 +18,7 @@ License
 #include "invertedCellCheck.H"
 #include "sumsAndMaxima.H"
 #include "vectorWidth.hpp"
+#include "hugePageLists.H"
 
 #include <string>
 #include <unordered_map>
@@ -369,6 +370,8 @@ Foam::invertedCellCheck::invertedCellCheck
     std::vector<label> points;
     DynamicList<label> hexPoints(8*mesh.nCells());
     DynamicList<label> hexCells(mesh.nCells());
+    adviseHugePages(hexPoints);
+    adviseHugePages(hexCells);
     DynamicList<label> otherStart, otherPoints, otherCells, otherLayout;
     for (label celli = 0; celli < mesh.nCells(); ++celli)
     {
@@ -409,6 +412,11 @@ Foam::invertedCellCheck::invertedCellCheck
     cellPoints_.transfer(otherPoints);
     otherCells_.transfer(otherCells);
     cellLayout_.transfer(otherLayout);
+    // (read at every check; a mesh of other cells than hexahedra shrank
+    // them into new storage)
+    onHugePages(hexPoints_);
+    onHugePages(hexCells_);
+    onHugePages(cellPoints_);
 }
 
 

@@ -25,6 +25,7 @@ License
 #include "PstreamBuffers.H"
 #include "indexedOctree.H"
 #include "treeDataPoint.H"
+#include "hugePageLists.H"
 
 #include <algorithm>
 #include <vector>
@@ -349,6 +350,11 @@ void Foam::rigidLayers::findFeet
     zoneFoot_.transfer(feet);
     zoneWeight_.transfer(weights);
     zoneArm_.transfer(arms);
+    // (swept at every step)
+    onHugePages(zonePoints_);
+    onHugePages(zoneFoot_);
+    onHugePages(zoneWeight_);
+    onHugePages(zoneArm_);
 }
 
 
