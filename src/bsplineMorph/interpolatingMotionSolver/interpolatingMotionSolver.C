@@ -116,7 +116,6 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
         rigidLayersPtr_->markRigid(rigid);
     }
     DynamicList<label> points(fixed.size());
-    adviseHugePages(points);
     forAll(fixed, pointi)
     {
         if (!fixed[pointi] && !(rigid.test(pointi) && !bc.constrains(pointi)))
