@@ -92,7 +92,7 @@ affineFit<D>::affineFit(const communicator& comm, int nc, pointsView<D> x,
 
 template <int D>
 void affineFit<D>::solve(const communicator& comm, pointsView<D> x, const std::vector<std::uint8_t>& mask,
-                         const double* values)
+                         const std::vector<double>& values)
 {
     constexpr int n = D + 1;
     std::vector<double> rhs(nc_*n, 0.0);

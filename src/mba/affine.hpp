@@ -41,7 +41,7 @@ public:
 
     /// Coefficients for values (point x component), reduced over ranks
     void solve(const communicator& comm, pointsView<D> x, const std::vector<std::uint8_t>& mask,
-               const double* values);
+               const std::vector<double>& values);
 
     void zero() { coeff_.assign(coeff_.size(), 0.0); }
 

@@ -46,8 +46,8 @@ class flatEvaluator
     /// where levels above flatLevel_ have coefficients at the point's
     /// stencil (a node with omega > 0; phi is 0 at the others), and those
     /// levels: bit j for level flatLevel_ + 1 + j
-    hugeVector<std::pair<std::uint32_t, std::uint32_t>> finerLevelPoints_;
-    hugeVector<stencilTiles<D>> finerLevelTiles_;  ///< their stencils' tiles at those levels, point after point
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> finerLevelPoints_;
+    std::vector<stencilTiles<D>> finerLevelTiles_; ///< their stencils' tiles at those levels, point after point
     std::pair<int, int> finerLevelsFoundFor_{-1, -1}; ///< (levels planned, flatLevel_) the two were found for
     /// evaluate()'s values in the sweep's (spatial) order, before they are
     /// put in the points' own order (a scratch array kept from call to call:

@@ -13,7 +13,7 @@
 
 namespace mba {
 
-/// The size of a huge page: arrays of it or more get mappings of their own
+/// Arrays smaller than this are allocated as usual (they hold no whole huge page)
 constexpr std::size_t hugePageBytes = std::size_t(2) << 20;
 
 /// Asks the kernel to back the whole 2 MiB pages inside [p, p + bytes) with
@@ -32,18 +32,15 @@ bool adviseHugePages(void* p, std::size_t bytes);
 /// are huge now.
 bool collapseHugePages(const void* p, std::size_t bytes);
 
-/// Memory for bytes (Linux with transparent huge pages; elsewhere, and under
-/// AddressSanitizer, operator new): at least hugePageBytes, a fresh mapping of
-/// whole huge pages that starts on one, advised for huge pages (so never
-/// written before); from 16 KiB, a block of the next power of two bytes from
-/// a pool of huge pages that keeps freed blocks for reuse (so many small
-/// arrays share huge pages); less, operator new. Throws std::bad_alloc.
+/// Memory for bytes: at least hugePageBytes, a fresh anonymous mapping advised
+/// for huge pages (so never written before); less, operator new. Throws
+/// std::bad_alloc.
 void* allocateHuge(std::size_t bytes);
 
 /// Frees what allocateHuge(bytes) returned
 void freeHuge(void* p, std::size_t bytes) noexcept;
 
-/// Allocator of allocateHuge/freeHuge, for the arrays that fits and evaluations sweep
+/// Allocator of allocateHuge/freeHuge, for the core's large arrays
 template <class T>
 struct hugeAllocator
 {
@@ -56,7 +53,7 @@ struct hugeAllocator
     template <class U> bool operator!=(const hugeAllocator<U>&) const { return false; }
 };
 
-/// A vector on huge pages (from 16 KiB)
+/// A vector on huge pages when large
 template <class T> using hugeVector = std::vector<T, hugeAllocator<T>>;
 
 } // namespace mba

@@ -135,7 +135,7 @@ void evalRun(const double* phi, int nc, const stencilTiles<D>& tid, const stenci
 } // namespace
 
 template <int D>
-void levelApplier<D>::apply(levelPlan<D>& L, hugeVector<double>& residuals)
+void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
 {
     const std::size_t nPhi = L.coefficientCount(ctrl_.nComponents);
     if (L.phi.size() != nPhi) L.phi.assign(nPhi, 0.0);
@@ -147,7 +147,7 @@ void levelApplier<D>::apply(levelPlan<D>& L, hugeVector<double>& residuals)
     // until storeDeferredCoefficients() stores them.
     clearLattice(L);
     computeStencils(L);
-    hugeVector<double>& rr = L.separated ? L.scaledResiduals : scaledResiduals_;
+    std::vector<double>& rr = L.separated ? L.scaledResiduals : scaledResiduals_;
     scaleResiduals(rr, residuals);
     scatterOwn(L, rr);
     L.allCoefficientsStored = !L.separated;
@@ -214,7 +214,7 @@ void levelApplier<D>::computeStencils(const levelPlan<D>& L)
 
 /// rr = r/sum(w^2) per point in order x component (0 where not constrained)
 template <int D>
-void levelApplier<D>::scaleResiduals(hugeVector<double>& rr, const hugeVector<double>& residuals) const
+void levelApplier<D>::scaleResiduals(std::vector<double>& rr, const std::vector<double>& residuals) const
 {
     const std::size_t nq = ctrl_.order.size();
     const int nc = ctrl_.nComponents;
@@ -233,7 +233,7 @@ void levelApplier<D>::scaleResiduals(hugeVector<double>& rr, const hugeVector<do
 /// nodes at once (coarse levels), short runs point after point: as the
 /// ranks holding them as ghosts form their sums (ghostPartialSums)
 template <int D>
-void levelApplier<D>::scatterOwn(levelPlan<D>& L, const hugeVector<double>& rr) const
+void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr) const
 {
     const std::size_t nq = ctrl_.order.size();
     const int nc = ctrl_.nComponents;
@@ -265,7 +265,7 @@ void levelApplier<D>::scatterOwn(levelPlan<D>& L, const hugeVector<double>& rr) 
 /// cleared) is overwritten. Every component, 0 in those the point does not
 /// constrain (no other point does there either)
 template <int D>
-void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const hugeVector<double>& rr) const
+void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const
 {
     const int nc = ctrl_.nComponents;
     for (std::size_t q = 0; q < L.lone.size(); ++q)
@@ -275,7 +275,7 @@ void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const hugeVector<double>&
 /// Exchange the partial delta at the requested tiles' nodes (nodesTo), or
 /// the residuals of the ghosts, and add the ranks' partial sums in rank order
 template <int D>
-void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const hugeVector<double>& residuals)
+void levelApplier<D>::exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals)
 {
     constexpr int npt = levelPlan<D>::npt;
     const int P = comm_.size(), nc = ctrl_.nComponents;
@@ -504,8 +504,8 @@ void levelApplier<D>::divideByOmega(levelPlan<D>& L, std::int64_t first, std::in
 /// (rr: the apply's r/sum(w^2), which give them at the points alone at
 /// their nodes)
 template <int D>
-void levelApplier<D>::subtractLevel(const levelPlan<D>& L, const hugeVector<double>& rr,
-                                    hugeVector<double>& residuals)
+void levelApplier<D>::subtractLevel(const levelPlan<D>& L, const std::vector<double>& rr,
+                                    std::vector<double>& residuals)
 {
     const std::size_t nq = ctrl_.order.size();
     const int nc = ctrl_.nComponents;

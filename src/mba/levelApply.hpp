@@ -21,10 +21,10 @@ class levelApplier
     const communicator& comm_;              ///< the ranks
     const domain<D>& dom_;                  ///< the lattices' domain (for the ghosts' coordinates)
     const controlPoints<D>& ctrl_;          ///< this rank's control points
-    hugeVector<stencil<D>> stencils_;       ///< the control points' stencils at the current level, in order
-    hugeVector<stencil<D>> cubedStencils_;  ///< the same with their weights cubed (for the scatter)
-    hugeVector<double> scaledResiduals_;    ///< r/sum(w^2) per point x component (levels not separated)
-    hugeVector<double> levelValues_;        ///< the current level's values at the control points, in order
+    std::vector<stencil<D>> stencils_;      ///< the control points' stencils at the current level, in order
+    std::vector<stencil<D>> cubedStencils_; ///< the same with their weights cubed (for the scatter)
+    std::vector<double> scaledResiduals_;   ///< r/sum(w^2) per point x component (levels not separated)
+    std::vector<double> levelValues_;       ///< the current level's values at the control points, in order
     std::vector<double> setAside_;          ///< own partial sums of the tiles shared with lower ranks
     std::vector<double> chunkSum_;          ///< one chunk's sum (chunked exchange), a round's values (tree)
     std::vector<double> treeSums_;          ///< the level's tiles of all ranks (tree exchange)
@@ -34,16 +34,16 @@ class levelApplier
 
     void clearLattice(levelPlan<D>& L) const;
     void computeStencils(const levelPlan<D>& L);
-    void scaleResiduals(hugeVector<double>& rr, const hugeVector<double>& residuals) const;
-    void scatterOwn(levelPlan<D>& L, const hugeVector<double>& rr) const;
-    void exchangePartialSums(levelPlan<D>& L, const hugeVector<double>& residuals);
+    void scaleResiduals(std::vector<double>& rr, const std::vector<double>& residuals) const;
+    void scatterOwn(levelPlan<D>& L, const std::vector<double>& rr) const;
+    void exchangePartialSums(levelPlan<D>& L, const std::vector<double>& residuals);
     void ghostPartialSums(const levelPlan<D>& L, int r, const std::vector<double>& got, std::vector<double>& dl);
     void addInRankOrder(levelPlan<D>& L, const std::vector<const double*>& got);
     void exchangeChunks(levelPlan<D>& L);
     void exchangeInTree(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L, std::int64_t first, std::int64_t n, const double* s) const;
-    void storeLonePoints(levelPlan<D>& L, const hugeVector<double>& rr) const;
-    void subtractLevel(const levelPlan<D>& L, const hugeVector<double>& rr, hugeVector<double>& residuals);
+    void storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const;
+    void subtractLevel(const levelPlan<D>& L, const std::vector<double>& rr, std::vector<double>& residuals);
 
 public:
     /// The points and domain are kept by reference: they must outlive the object
@@ -54,7 +54,7 @@ public:
 
     /// Fits level L to the residuals (point x component) and subtracts the
     /// level's values from them. Collective.
-    void apply(levelPlan<D>& L, hugeVector<double>& residuals);
+    void apply(levelPlan<D>& L, std::vector<double>& residuals);
 
     /// Bytes of the work arrays that the plan's size counts (all but levelValues_)
     std::int64_t bytes() const;

@@ -84,7 +84,7 @@ struct levelPlan
     /// other ranks' sums arrive in) nor scaled by 1/omega nor swept.
     bool separated = false;
     std::vector<std::uint8_t> readEveryFit;    ///< separated: per own point in order, its phi is stored every fit
-    hugeVector<double> scaledResiduals;        ///< separated: per own point x component, r/sum(w^2) of the last fit
+    std::vector<double> scaledResiduals;       ///< separated: per own point x component, r/sum(w^2) of the last fit
     mutable bool allCoefficientsStored = true; ///< every own point's phi stored since the last fit
 
     std::vector<std::vector<std::int64_t>> tilesTo;   ///< per rank: own tiles (view ids) whose partial sums it gets
@@ -93,7 +93,7 @@ struct levelPlan
     /// Own tiles (view ids) that a lower rank also contributes to: this
     /// rank's partial sums there are set aside and added in rank order
     std::vector<std::int64_t> sharedWithLower;
-    hugeVector<stencilTiles<D>> controlTiles;  ///< the view tiles of the own control points' stencils, in order
+    std::vector<stencilTiles<D>> controlTiles; ///< the view tiles of the own control points' stencils, in order
 
     /// Per rank of the direct exchange: whether the partial sums towards
     /// it (To) and from it (From) go as ghosts (the sender's residuals, see

@@ -31,7 +31,7 @@ class levelPlanner
     levelPlan<D> L_;                    ///< the plan being made
     index<D> nodes_;                    ///< the level's nodes per direction
     std::int64_t nOwn_ = 0;             ///< own tiles
-    hugeVector<stencilTiles<D>> ownIds_;  ///< the own points' stencil tiles in the own layout, in order
+    std::vector<stencilTiles<D>> ownIds_; ///< the own points' stencil tiles in the own layout, in order
     /// per own tile and omega value: the nodes where this rank's partial
     /// omega is > 0 (bit n: node n), where a weight w of a point it holds
     /// has w^2 > 0

@@ -53,7 +53,7 @@ struct multilevel<D>::state
     affineFit<D> affine;                ///< the affine start (none unless parameters.affine)
     queryClusters<D> clusters;          ///< this rank's query points in clusters (parallel only)
     std::deque<levelPlan<D>> levels;    ///< the levels planned so far (a fit plans those it needs)
-    hugeVector<double> residuals;       ///< per control point x component: what the levels so far leave
+    std::vector<double> residuals;      ///< per control point x component: what the levels so far leave
     levelApplier<D> applier;            ///< a level's apply and its work arrays
     flatEvaluator<D> evaluator;         ///< the evaluation at the planned points
     fitReport report;                   ///< of the last fit
@@ -251,7 +251,7 @@ template <int D>
 void multilevel<D>::state::startResiduals(const std::vector<double>& values)
 {
     const int nc = ctrl.nComponents;
-    residuals.assign(values.begin(), values.end());
+    residuals = values;
     if (trend.active())
     {
         for (std::size_t i = 0; i < ctrl.x.size; ++i)
@@ -263,7 +263,7 @@ void multilevel<D>::state::startResiduals(const std::vector<double>& values)
         }
     }
     if (!parameters.affine) return;
-    affine.solve(comm, ctrl.x, ctrl.mask, residuals.data());
+    affine.solve(comm, ctrl.x, ctrl.mask, residuals);
     for (std::size_t i = 0; i < ctrl.x.size; ++i)
     {
         double g[3] = {0, 0, 0};
