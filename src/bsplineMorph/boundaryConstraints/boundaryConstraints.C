@@ -25,6 +25,7 @@ License
 #include "cyclicPolyPatch.H"
 #include "processorPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
+#include "unitConversion.H"
 
 #include <algorithm>
 #include <cmath>
@@ -102,12 +103,14 @@ Foam::label Foam::nOwnedGlobal(const boolList& owned)
 Foam::boundaryConstraints::boundaryConstraints
 (
     const pointVectorField& pointDisplacement,
-    const pointField& points0
+    const pointField& points0,
+    const scalar curvedSlipAngle
 )
 :
     pMesh_(pointDisplacement.mesh()),
     frame_(std::make_shared<const solutionFrame>(pMesh_(), points0)),
-    nCyclicGlobal_(0)
+    nCyclicGlobal_(0),
+    curvedSlipCos_(std::cos(degToRad(curvedSlipAngle)))
 {
     const polyMesh& mesh = pMesh_();
     owned_ = ownedPoints(mesh);
@@ -240,7 +243,8 @@ Foam::boundaryConstraints::boundaryConstraints
     owned_(bc.owned_),
     boundaryPoints_(bc.boundaryPoints_),
     cyclicPoints_(bc.cyclicPoints_),
-    nCyclicGlobal_(bc.nCyclicGlobal_)
+    nCyclicGlobal_(bc.nCyclicGlobal_),
+    curvedSlipCos_(bc.curvedSlipCos_)
 {
     for (const label pointi : bc.projected_)
     {

@@ -29,7 +29,6 @@ Description
 #include "OStringStream.H"
 #include "HashOps.H"
 #include "hugePageLists.H"
-#include "unitConversion.H"
 
 #include <cmath>
 
@@ -238,10 +237,10 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip(const polyPatch& patch)
     }
     shared->sum(sum);
     shared->sum(count);
-    // Bent smoothly: |sum| of unit normals within (cos 30 deg, 1) of their
-    // count (two faces: within 60 deg of each other; coplanar ones to
-    // rounding, 1e-9, keep their own normals)
-    const scalar smooth = std::cos(degToRad(30.0));
+    // Bent smoothly: |sum| of unit normals within (cos curvedSlipAngle, 1)
+    // of their count (two faces: within twice the angle of each other;
+    // coplanar ones to rounding, 1e-9, keep their own normals)
+    const scalar smooth = curvedSlipCos_;
     vectorField mean(patch.nPoints(), Zero);
     bool bent = false;
     forAll(sum, lp)

@@ -213,6 +213,7 @@ void Foam::interpolatingMotionSolver::warnUnknownKeywords
     const dictionary& dict = coeffDict();
     wordList all(known);
     all.append("invertedCells");
+    all.append("curvedSlipAngle");
     all.append("rigidLayers");
     if (dict.dictName() == coeffsName)
     {
@@ -289,6 +290,10 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    curvedSlipAngle_
+    (
+        coeffsInput::getInRange<scalar>(coeffDict(), "curvedSlipAngle", 30, 0, 90)
+    ),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
@@ -306,6 +311,10 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    curvedSlipAngle_
+    (
+        coeffsInput::getInRange<scalar>(coeffDict(), "curvedSlipAngle", 30, 0, 90)
+    ),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
@@ -348,7 +357,7 @@ bool Foam::interpolatingMotionSolver::updateControls()
     {
         constraintsPtr_.reset
         (
-            new boundaryConstraints(pointDisplacement_, points0())
+            new boundaryConstraints(pointDisplacement_, points0(), curvedSlipAngle_)
         );
     }
     else
