@@ -133,13 +133,12 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     outerDistance_ = coeffsInput::getRequiredInRange<scalar>(dict, "outerDistance", 0);
     if (!(outerDistance_ > innerDistance_))
     {
-        // (the message in a stream of the log's precision)
-        const logPrecision digits;
-        OStringStream msg;
-        msg << "outerDistance " << outerDistance_ << " must be larger than"
-            << " innerDistance " << innerDistance_ << " (the blend lies between"
-            << " them)";
-        FatalIOErrorInFunction(dict) << msg.str().c_str() << exit(FatalIOError);
+        coeffsInput::fatalInput(dict, [&](Ostream& os)
+        {
+            os  << "outerDistance " << outerDistance_ << " must be larger than"
+                << " innerDistance " << innerDistance_ << " (the blend lies"
+                << " between them)";
+        });
     }
 }
 
