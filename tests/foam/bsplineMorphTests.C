@@ -413,7 +413,7 @@ TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bs
     const std::string inverted = errorOf("invertedCells maybe;");
     CHECK_THAT(inverted, Contains("'invertedCells' is 'maybe'") && Contains("fatal") && Contains("warn")
         && Contains("default fatal"));
-    CHECK_THAT(errorOf("curvedSlipAngle 100;"), Contains("'curvedSlipAngle' is 100") && Contains("from 0 to 90")
+    CHECK_THAT(errorOf("curvedSlipAngle 90;"), Contains("'curvedSlipAngle' is 90") && Contains("from 0 to 89")
         && Contains("default 30"));
     CHECK(errorOf("curvedSlipAngle 45;") == "no error");
     CHECK_THAT(errorOf("relativeTolerance perhaps;"), Contains("perhaps"));
@@ -466,7 +466,7 @@ TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][
     CHECK_THAT(errorOf("function thinPlateSpline; polynomial false;", "RBF"),
         Contains("thinPlateSpline") && Contains("polynomial"));
     CHECK_THAT(errorOf("invertedCells maybe;", "RBF"), Contains("'invertedCells' is 'maybe'"));
-    CHECK_THAT(errorOf("curvedSlipAngle -1;", "RBF"), Contains("'curvedSlipAngle' is -1") && Contains("from 0 to 90"));
+    CHECK_THAT(errorOf("curvedSlipAngle -1;", "RBF"), Contains("'curvedSlipAngle' is -1") && Contains("from 0 to 89"));
     CHECK(errorOf("function wendlandC2; supportRadius 2; polynomial false;", "RBF") == "no error");
 }
 

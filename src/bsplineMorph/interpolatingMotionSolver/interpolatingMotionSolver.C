@@ -48,6 +48,16 @@ namespace Foam
                 dict, "invertedCells", onInvertedNames, onInverted::fatal
             ) == onInverted::fatal;
         }
+
+        // (below 90 deg: faces at a point that turn back on each other, whose
+        // normals cancel, keep a mean normal well above round-off)
+        scalar readCurvedSlipAngle(const dictionary& dict)
+        {
+            return coeffsInput::getInRange<scalar>
+            (
+                dict, "curvedSlipAngle", 30, 0, 89
+            );
+        }
     }
 }
 
@@ -290,10 +300,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    curvedSlipAngle_
-    (
-        coeffsInput::getInRange<scalar>(coeffDict(), "curvedSlipAngle", 30, 0, 90)
-    ),
+    curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
@@ -311,10 +318,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
-    curvedSlipAngle_
-    (
-        coeffsInput::getInRange<scalar>(coeffDict(), "curvedSlipAngle", 30, 0, 90)
-    ),
+    curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
