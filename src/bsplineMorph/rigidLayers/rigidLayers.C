@@ -133,12 +133,14 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     outerDistance_ = coeffsInput::getRequiredInRange<scalar>(dict, "outerDistance", 0);
     if (!(outerDistance_ > innerDistance_))
     {
-        coeffsInput::fatalInput(dict, [&](Ostream& os)
-        {
-            os  << "outerDistance " << outerDistance_ << " must be larger than"
-                << " innerDistance " << innerDistance_ << " (the blend lies"
-                << " between them)";
-        });
+        FatalIOErrorInFunction(dict)
+            << coeffsInput::inputMessage([&](Ostream& os)
+               {
+                   os  << "outerDistance " << outerDistance_ << " must be larger"
+                       << " than innerDistance " << innerDistance_ << " (the blend"
+                       << " lies between them)";
+               }).c_str()
+            << exit(FatalIOError);
     }
 }
 
