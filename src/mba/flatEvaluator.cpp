@@ -240,12 +240,30 @@ void flatEvaluator<D>::addAffine(const indexBox<D>& b, const affineFit<D>& affin
     });
 }
 
-/// flatPhi_ (on the node box b of L's level) += L's coefficients in the box
+/// flatPhi_ (on the node box b of L's level) += L's coefficients in the
+/// box: those stored, and the lone points' (w r/sum(w^2) at their nodes)
 template <int D>
 void flatEvaluator<D>::addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b)
 {
     constexpr int npt = levelPlan<D>::npt;
-    for (std::int64_t id = 0; id < L.view.size(); ++id)
+    for (std::size_t j = 0; j < L.lonePoints.size(); ++j)
+    {
+        const stencil<D> st = ctrl_.stencilAt(L.lonePoints[j], L.scale);
+        indexBox<D> nb;
+        for (int d = 0; d < D; ++d) { nb.lo[d] = st.base[d]; nb.hi[d] = st.base[d] + 3; }
+        const double* rr = &L.loneResiduals[j*nc_];
+        forEachIndex<D>(nb, [&](const index<D>& n) {
+            double w = 1;
+            for (int d = 0; d < D; ++d)
+            {
+                if (n[d] < b.lo[d] || n[d] > b.hi[d]) return;
+                w *= st.w[d][n[d] - st.base[d]];
+            }
+            double* o = &flatPhi_[boxIndex<D>(b, n)*nc_];
+            for (int c = 0; c < nc_; ++c) o[c] += w*rr[c];
+        });
+    }
+    for (std::int64_t id = 0; id < L.storedTiles; ++id)
     {
         const index<D> t = L.view.coord(L.view.keyOf(id));
         indexBox<D> tb, nb;     // the tile's nodes; those in the box
@@ -271,7 +289,9 @@ void flatEvaluator<D>::addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b
 /// levels whose lattice has a node with omega > 0 and a non-zero weight in
 /// the point's stencil. Where a level has no tile at the stencil, no finer
 /// level has one (their nodes lie within the stencils of the same control
-/// points). Returns, for separated levels, the view tiles that this reads.
+/// points). With them the stencil's stored tiles (-1 for the others) and
+/// the lone points whose nodes it meets (forEachLoneOverlap). Returns, for
+/// separated levels, the view tiles that this reads.
 template <int D>
 std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const std::deque<levelPlan<D>>& levels)
 {
@@ -280,10 +300,13 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     precondition(nPlanned - flatLevel_ - 1 <= 32, "mba: more than 32 levels above the flat lattice");
     finerLevelPoints_.clear();
     finerLevelTiles_.clear();
+    finerLonePairs_.clear();
+    finerLoneCounts_.clear();
     std::vector<std::vector<std::uint8_t>> read(levels.size());
     for (int k = flatLevel_ + 1; k < nPlanned; ++k)
         if (levels[k].separated) read[k].assign(levels[k].view.size(), 0);
     stencilTiles<D> tid;
+    std::vector<std::uint32_t> scratch;
     for (std::size_t q = 0; q < eval_.size(); ++q)
     {
         std::uint32_t m = 0;
@@ -294,13 +317,21 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
             if (!coefficientWeights(L, q, tid, w)) break;
             if (!(w[0] + w[1] + w[2] > 0)) continue;
             m |= std::uint32_t(1) << (k - flatLevel_ - 1);
-            finerLevelTiles_.push_back(tid);
             if (!read[k].empty()) for (const std::int32_t id : tid) if (id >= 0) read[k][id] = 1;
+            const std::size_t first = finerLonePairs_.size();
+            forEachLoneOverlap(L, ctrl_, levelStencil<D>(eval_.u0[q], L.scale), tid, scratch,
+                               [&](std::uint32_t j, double K) { finerLonePairs_.push_back({K, j}); });
+            precondition(finerLonePairs_.size() - first <= 0xffff, "mba: a point meets too many lone points");
+            finerLoneCounts_.push_back(std::uint16_t(finerLonePairs_.size() - first));
+            for (std::int32_t& id : tid) if (id >= L.storedTiles) id = -1;
+            finerLevelTiles_.push_back(tid);
         }
         if (m) finerLevelPoints_.emplace_back(std::uint32_t(q), m);
     }
     finerLevelPoints_.shrink_to_fit();
     finerLevelTiles_.shrink_to_fit();
+    finerLonePairs_.shrink_to_fit();
+    finerLoneCounts_.shrink_to_fit();
     return read;
 }
 
@@ -412,9 +443,12 @@ template <int D>
 void flatEvaluator<D>::addFinerLevels(const std::deque<levelPlan<D>>& levels, int nLevels, double* values) const
 {
     const stencilTiles<D>* tiles = finerLevelTiles_.data();
+    const std::uint16_t* nPairs = finerLoneCounts_.data();
+    const lonePair* pair = finerLonePairs_.data();
     for (const auto& qm : finerLevelPoints_)
     {
         const std::size_t q = qm.first;
+        double* v = &values[q*nc_];
         int k = flatLevel_ + 1;
         for (std::uint32_t m = qm.second; m; m >>= 1, ++k)
         {
@@ -422,9 +456,12 @@ void flatEvaluator<D>::addFinerLevels(const std::deque<levelPlan<D>>& levels, in
             if (k < nLevels)
             {
                 const levelPlan<D>& L = levels[k];
-                evalStencil(L.phi.data(), nc_, *tiles, levelStencil<D>(eval_.u0[q], L.scale), &values[q*nc_]);
+                evalStencil(L.phi.data(), nc_, *tiles, levelStencil<D>(eval_.u0[q], L.scale), v);
+                for (const lonePair* p = pair; p != pair + *nPairs; ++p)
+                    for (int c = 0; c < nc_; ++c) v[c] += p->K*L.loneResiduals[p->j*nc_ + c];
             }
             ++tiles;
+            pair += *nPairs++;
         }
     }
 }
@@ -434,7 +471,8 @@ std::int64_t flatEvaluator<D>::bytes() const
 {
     return std::int64_t((flatPhi_.capacity() + refineScratch_.capacity() + sweptValues_.capacity())*sizeof(double)
         + finerLevelPoints_.capacity()*sizeof(finerLevelPoints_[0])
-        + finerLevelTiles_.capacity()*sizeof(stencilTiles<D>));
+        + finerLevelTiles_.capacity()*sizeof(stencilTiles<D>)
+        + finerLonePairs_.capacity()*sizeof(lonePair) + finerLoneCounts_.capacity()*sizeof(std::uint16_t));
 }
 
 template class flatEvaluator<2>;

@@ -47,7 +47,18 @@ class flatEvaluator
     /// stencil (a node with omega > 0; phi is 0 at the others), and those
     /// levels: bit j for level flatLevel_ + 1 + j
     std::vector<std::pair<std::uint32_t, std::uint32_t>> finerLevelPoints_;
-    std::vector<stencilTiles<D>> finerLevelTiles_; ///< their stencils' tiles at those levels, point after point
+    /// their stencils' stored tiles at those levels (-1 for the others:
+    /// levelPlan::storedTiles), point after point
+    std::vector<stencilTiles<D>> finerLevelTiles_;
+    /// A lone point (levelPlan::lone) j of a level whose nodes a stencil
+    /// meets: it adds K times its loneResiduals there (forEachLoneOverlap)
+    struct lonePair
+    {
+        double K;
+        std::uint32_t j;
+    };
+    std::vector<lonePair> finerLonePairs_;          ///< per entry of finerLevelTiles_, its lone points
+    std::vector<std::uint16_t> finerLoneCounts_;    ///< per entry of finerLevelTiles_, how many
     std::pair<int, int> finerLevelsFoundFor_{-1, -1}; ///< (levels planned, flatLevel_) the two were found for
     /// evaluate()'s values in the sweep's (spatial) order, before they are
     /// put in the points' own order (a scratch array kept from call to call:

@@ -169,7 +169,7 @@ void levelApplier<D>::apply(levelPlan<D>& L, std::vector<double>& residuals)
         }
     }
     else if (L.tree) divideByOmega(L, 0, std::int64_t(L.invOmega.size())/ctrl_.omegaPerNode, L.invOmega.data());
-    storeLonePoints(L, rr);
+    keepLoneResiduals(L, rr);
     subtractLevel(L, rr, residuals);
 }
 
@@ -259,17 +259,15 @@ void levelApplier<D>::scatterOwn(levelPlan<D>& L, const std::vector<double>& rr)
     }
 }
 
-/// The lone points' phi (levelPlan::lone): w r/sum(w^2) at their nodes, as
-/// a separated level stores it. After the exchange and the divide: what
-/// those nodes hold until then (0, or the last fit's phi where they are not
-/// cleared) is overwritten. Every component, 0 in those the point does not
-/// constrain (no other point does there either)
+/// The lone points' r/sum(w^2) (levelPlan::loneResiduals), from which the
+/// evaluations form their part of the level's values (their coefficients
+/// are not stored)
 template <int D>
-void levelApplier<D>::storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const
+void levelApplier<D>::keepLoneResiduals(levelPlan<D>& L, const std::vector<double>& rr) const
 {
     const int nc = ctrl_.nComponents;
-    for (std::size_t q = 0; q < L.lone.size(); ++q)
-        if (L.lone[q]) scatterSeparated<D>(L.phi.data(), nc, L.controlTiles[q], stencils_[q], &rr[q*nc], nullptr);
+    for (std::size_t j = 0; j < L.lonePoints.size(); ++j)
+        std::copy_n(&rr[std::size_t(L.lonePoints[j])*nc], nc, &L.loneResiduals[j*nc]);
 }
 
 /// Exchange the partial delta at the requested tiles' nodes (nodesTo), or

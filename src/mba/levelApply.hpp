@@ -42,7 +42,7 @@ class levelApplier
     void exchangeChunks(levelPlan<D>& L);
     void exchangeInTree(levelPlan<D>& L);
     void divideByOmega(levelPlan<D>& L, std::int64_t first, std::int64_t n, const double* s) const;
-    void storeLonePoints(levelPlan<D>& L, const std::vector<double>& rr) const;
+    void keepLoneResiduals(levelPlan<D>& L, const std::vector<double>& rr) const;
     void subtractLevel(const levelPlan<D>& L, const std::vector<double>& rr, std::vector<double>& residuals);
 
 public:

@@ -57,7 +57,13 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
         L_.receiveCounts[r] = nc_*(L_.byGhostsFrom[r] ? L_.ghostTiles[r].size()
                                                       : std::size_t(nodeCount(L_.nodesFrom[r])));
     if (nRanks_ > 1) chooseExchange();
-    if (!L_.separated && !L_.chunked && !L_.tree) findCoefficientRuns();
+    L_.storedTiles = L_.view.size();
+    if (!L_.separated && !L_.chunked && !L_.tree)
+    {
+        if (!L_.lone.empty() && !L_.view.dense()) storeLoneTilesLast();
+        findCoefficientRuns();
+    }
+    if (!L_.lone.empty()) indexLonePoints();
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
     {
@@ -115,13 +121,88 @@ void levelPlanner<D>::keepOmega()
     hugeVector<double>().swap(L_.invOmega);
 }
 
+/// Numbers last the view tiles (sparse) that hold lone points' nodes alone,
+/// which then hold no phi (levelPlan::storedTiles): the tiles of the points
+/// that are not lone, and those that partial sums go to or come from, are
+/// kept first, in their order. Plain levels (the others' exchanges write
+/// their own tiles whole)
+template <int D>
+void levelPlanner<D>::storeLoneTilesLast()
+{
+    const std::int64_t n = L_.view.size();
+    std::vector<std::uint8_t> kept(n, 0);
+    for (std::size_t q = 0; q < L_.lone.size(); ++q)
+        if (!L_.lone[q]) for (const std::int32_t id : L_.controlTiles[q]) if (id >= 0) kept[id] = 1;
+    for (int r = 0; r < nRanks_; ++r)
+    {
+        for (const std::int64_t id : L_.tilesTo[r]) kept[id] = 1;
+        for (const std::int64_t id : L_.tilesFrom[r]) kept[id] = 1;
+    }
+    std::vector<std::int64_t> order(n), to(n);
+    for (std::int64_t id = 0; id < n; ++id) order[id] = id;
+    std::stable_partition(order.begin(), order.end(), [&](std::int64_t id) { return kept[id] != 0; });
+    L_.storedTiles = std::count(kept.begin(), kept.end(), std::uint8_t(1));
+    if (L_.storedTiles == n) return;
+    tileLayout<D> view;
+    view.init(nodes_, false);
+    for (std::int64_t t = 0; t < n; ++t) to[order[t]] = view.findOrInsertKey(L_.view.keyOf(order[t]));
+    L_.view = std::move(view);
+    // the arrays by tile id, in the new order: in place, cycle after cycle
+    // (1/omega is the plan's largest array while it is made)
+    std::vector<std::uint8_t> done(n);
+    const auto permute = [&](auto& v, std::size_t per) {
+        std::fill(done.begin(), done.end(), 0);
+        typename std::decay<decltype(v)>::type held(per);
+        for (std::int64_t first = 0; first < n; ++first)
+        {
+            if (done[first]) continue;
+            std::copy_n(&v[first*per], per, held.begin());
+            for (std::int64_t id = to[first]; ; id = to[id])
+            {
+                std::swap_ranges(held.begin(), held.end(), v.begin() + id*per);
+                done[id] = 1;
+                if (id == first) break;
+            }
+        }
+    };
+    permute(L_.coefficientNodes, std::size_t(omegaPerNode_));
+    permute(L_.invOmega, std::size_t(npt*omegaPerNode_));
+    permute(loneNodes_, std::size_t(npt));
+    for (stencilTiles<D>& tid : L_.controlTiles)
+        for (std::int32_t& id : tid) if (id >= 0) id = std::int32_t(to[id]);
+    for (auto* lists : {&L_.tilesTo, &L_.tilesFrom})
+        for (auto& tiles : *lists)
+            for (std::int64_t& id : tiles) id = to[id];
+    for (std::int64_t& id : L_.sharedWithLower) id = to[id];
+    for (std::int64_t& id : ownToView_) id = to[id];
+}
+
+/// levelPlan::lonePoints and the lone points of each view tile
+template <int D>
+void levelPlanner<D>::indexLonePoints()
+{
+    const std::size_t nt = std::size_t(L_.view.size());
+    for (std::size_t q = 0; q < L_.lone.size(); ++q)
+        if (L_.lone[q]) L_.lonePoints.push_back(std::uint32_t(q));
+    std::vector<std::uint32_t>& start = L_.loneTileStart;
+    start.assign(nt + 1, 0);
+    for (const std::uint32_t q : L_.lonePoints)
+        for (const std::int32_t id : L_.controlTiles[q]) if (id >= 0) ++start[id + 1];
+    for (std::size_t t = 0; t < nt; ++t) start[t + 1] += start[t];
+    L_.loneOnTile.resize(start[nt]);
+    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+    for (std::uint32_t j = 0; j < L_.lonePoints.size(); ++j)
+        for (const std::int32_t id : L_.controlTiles[L_.lonePoints[j]]) if (id >= 0) L_.loneOnTile[at[id]++] = j;
+    L_.loneResiduals.assign(L_.lonePoints.size()*nc_, 0.0);
+}
+
 /// levelPlan::coefficientRuns from coefficientNodes, less the lone points'
 /// nodes (loneNodes_)
 template <int D>
 void levelPlanner<D>::findCoefficientRuns()
 {
     const int per = omegaPerNode_;
-    const std::int64_t nNodes = L_.view.size()*npt;
+    const std::int64_t nNodes = L_.storedTiles*npt;
     const auto coefficient = [&](std::int64_t n) {
         std::uint64_t any = 0;
         for (int j = 0; j < per; ++j) any |= L_.coefficientNodes[(n/npt)*per + j];
@@ -523,9 +604,11 @@ void levelPlanner<D>::fillStats()
     for (const std::uint8_t l : L.lone) s.lonePoints += l;
     s.chunked = L.chunked;
     s.tree = L.tree;
-    s.nodes = L.view.size()*npt;
+    s.nodes = L.storedTiles*npt;
     // (phi as the first apply allocates it)
-    s.bytes = std::int64_t((L.coefficientCount(nc_) + L.invOmega.capacity() + L.runScales.capacity())*sizeof(double)
+    s.bytes = std::int64_t((L.coefficientCount(nc_) + L.invOmega.capacity() + L.runScales.capacity()
+                            + L.loneResiduals.capacity())*sizeof(double)
+        + (L.lonePoints.capacity() + L.loneTileStart.capacity() + L.loneOnTile.capacity())*sizeof(std::uint32_t)
         + L.coefficientNodes.capacity()*sizeof(std::uint64_t)
         + L.ownLayout.bytes() + L.view.bytes() + L.sharedWithLower.capacity()*sizeof(std::int64_t)
         + L.controlTiles.capacity()*sizeof(stencilTiles<D>) + L.readEveryFit.capacity()

@@ -28,6 +28,7 @@
 #include "pointSets.hpp"
 #include "chunkExchange.hpp"
 
+#include <algorithm>
 #include <deque>
 #include <functional>
 #include <utility>
@@ -58,8 +59,12 @@ struct levelPlan
     tileLayout<D> ownLayout;        ///< tiles holding this rank's partial sums (empty when ownIsView)
     tileLayout<D> view;             ///< own and received tiles: where phi and 1/omega are stored
     bool ownIsView = false;         ///< serial, sparse: the own tiles are the view (ownLayout left empty)
+    /// The view tiles [0, storedTiles) hold phi; the others hold nodes of
+    /// lone points alone (lone), whose coefficients are not stored: a
+    /// sparse view numbers those tiles last (levelPlanner::storeLoneTilesLast)
+    std::int64_t storedTiles = 0;
 
-    /// The coefficients at the view's nodes (tile id x node x component);
+    /// The coefficients at the stored tiles' nodes (tile id x node x component);
     /// during an apply first the partial sums delta. Allocated by the first
     /// apply (a level that no evaluation point reads never has them: see
     /// unreadLevel). Mutable: a separated level's apply stores phi only
@@ -144,13 +149,23 @@ struct levelPlan
     /// in the components it constrains and 0 in the others: no other point
     /// of any rank reaches those nodes), with no tile that another rank reads
     /// and no neighbour in order with its first node (a run). Its nodes then
-    /// take phi = w r/sum(w^2) from it alone, as on a separated level,
-    /// stored after the exchange and the divide, and its residual after the
-    /// level is r - (r/sum(w^2)) sum(w^2): the same values to round-off,
-    /// without the clear, the divide and the sweep (coefficientRuns leave
-    /// its nodes out). Fine levels, where most points are alone and a few
+    /// take phi = w r/sum(w^2) from it alone, as on a separated level, and
+    /// its residual after the level is r - (r/sum(w^2)) sum(w^2). Those
+    /// coefficients are not stored (phi is 0 at its nodes): where a stencil
+    /// meets its nodes, they add K r/sum(w^2) to the value there, K the
+    /// product over the directions of the two stencils' overlapping
+    /// weights (forEachLoneOverlap). The same values to round-off, without
+    /// the clear, the divide, the sweep and the tiles that hold lone points'
+    /// nodes alone. Fine levels, where most points are alone and a few
     /// share nodes (sphereInBox's level 8: 3010 of 4620). Empty: none
     std::vector<std::uint8_t> lone;
+    std::vector<std::uint32_t> lonePoints;   ///< the lone points' positions in order, ascending
+    /// Per view tile t, the lone points (indices into lonePoints) whose
+    /// stencils touch it: loneOnTile[loneTileStart[t] .. loneTileStart[t + 1])
+    std::vector<std::uint32_t> loneTileStart, loneOnTile;
+    /// Per lone point x component, r/sum(w^2) of the last fit (0 in the
+    /// components it leaves free): its coefficients are w times these
+    std::vector<double> loneResiduals;
 
     /// Some evaluation point reads the level (found only for
     /// params::stopUnread; a fit stops before a level that none reads)
@@ -162,8 +177,41 @@ struct levelPlan
     const tileLayout<D>& ownTiles() const { return ownIsView ? view : ownLayout; }
 
     /// The values phi holds once allocated (nc a node)
-    std::size_t coefficientCount(int nc) const { return std::size_t(view.size())*npt*nc; }
+    std::size_t coefficientCount(int nc) const { return std::size_t(storedTiles)*npt*nc; }
 };
+
+/// f(j, K) for each lone point j of L (lonePoints[j]; ctrl: this rank's
+/// control points) whose stencil shares nodes with st, once each, j
+/// ascending (tid: st's tiles in L.view, -1 where absent; scratch: a work
+/// array). K is the sum over the shared nodes of the product of the two
+/// stencils' weights: the point's coefficients add K times its
+/// loneResiduals to the value at st. Pairs whose K is 0 are skipped.
+template <int D, class F>
+void forEachLoneOverlap(const levelPlan<D>& L, const controlPoints<D>& ctrl, const stencil<D>& st,
+                        const stencilTiles<D>& tid, std::vector<std::uint32_t>& scratch, F f)
+{
+    if (L.lonePoints.empty()) return;
+    scratch.clear();
+    for (const std::int32_t id : tid)
+        if (id >= 0) scratch.insert(scratch.end(), L.loneOnTile.begin() + L.loneTileStart[id],
+                                    L.loneOnTile.begin() + L.loneTileStart[id + 1]);
+    std::sort(scratch.begin(), scratch.end());
+    scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+    for (const std::uint32_t j : scratch)
+    {
+        const stencil<D> c = ctrl.stencilAt(L.lonePoints[j], L.scale);
+        double K = 1;
+        for (int d = 0; d < D && K != 0; ++d)
+        {
+            // node base + a of st is node a - off of c's
+            const int off = int(c.base[d] - st.base[d]);
+            double s = 0;
+            for (int a = std::max(0, off); a <= std::min(3, 3 + off); ++a) s += st.w[d][a]*c.w[d][a - off];
+            K *= s;
+        }
+        if (K != 0) f(j, K);
+    }
+}
 
 /// What a fit keeps of a level that no evaluation point reads
 /// (params::stopUnread): its index, scale and plan statistics, read false

@@ -64,6 +64,8 @@ class levelPlanner
     bool aloneAtNodes(std::size_t q, const stencil<D>& st, bool freeZero) const;
     void testSeparation();
     void findLonePoints();
+    void storeLoneTilesLast();
+    void indexLonePoints();
     void findGhostTiles();
     void chooseExchange();
     /// The nodes of own tile o where this rank's partial omega is > 0 (bit

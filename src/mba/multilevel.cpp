@@ -365,15 +365,24 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values, int trend
 template <int D>
 void multilevel<D>::state::addLevels(const double* x, double* out, int nLevels) const
 {
+    const int nc = ctrl.nComponents;
     affine.addTo(x, out);
     const point<D> u0 = dom.local0(x);
-    trend.addAt(u0, ctrl.nComponents, out);
+    trend.addAt(u0, nc, out);
+    stencilTiles<D> tid;
+    std::vector<std::uint32_t> scratch;
     for (int k = 0; k < nLevels; ++k)
     {
         const levelPlan<D>& L = levels[k];
-        // No stored tile here: none at finer levels either (their nodes lie
-        // within the stencils of the same control points)
-        if (!evalStencil(L.view, L.phi.data(), ctrl.nComponents, levelStencil<D>(u0, L.scale), out)) break;
+        const stencil<D> st = levelStencil<D>(u0, L.scale);
+        // No tile here: none at finer levels either (their nodes lie within
+        // the stencils of the same control points)
+        if (!findTiles(L.view, st, tid)) break;
+        forEachLoneOverlap(L, ctrl, st, tid, scratch, [&](std::uint32_t j, double K) {
+            for (int c = 0; c < nc; ++c) out[c] += K*L.loneResiduals[j*nc + c];
+        });
+        for (std::int32_t& id : tid) if (id >= L.storedTiles) id = -1;
+        evalStencil(L.phi.data(), nc, tid, st, out);
     }
 }
 

@@ -451,16 +451,5 @@ void evalStencil(const double* phi, int nc, const stencilTiles<D>& tid, const st
     }
 }
 
-/// Adds the lattice's value at a stencil to out[0..nc). Returns whether any of
-/// the stencil's tiles exists.
-template <int D>
-bool evalStencil(const tileLayout<D>& L, const double* phi, int nc, const stencil<D>& st, double* out)
-{
-    stencilTiles<D> tid;
-    if (!findTiles(L, st, tid)) return false;
-    evalStencil(phi, nc, tid, st, out);
-    return true;
-}
-
 } // namespace mba
 #endif

@@ -215,7 +215,7 @@ TEST_CASE("each rank receives a small part of the finest level (surface, 8 slabs
     {
         multilevel<3> m(serial(), p, 1, c, {}, e);
         levels = m.fit(v).levels;
-        serialNodes = m.stats()[levels - 1].nodes;
+        serialNodes = m.stats()[levels - 1].viewTiles*tileLayout<3>::nodesPerTile;
     }
     REQUIRE(levels >= 7);
     const int P = 8;

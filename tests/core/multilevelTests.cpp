@@ -240,6 +240,13 @@ std::vector<levelStats> equalsPlainMBA(const std::vector<point<D>>& c, const std
     const std::vector<double> ref = plainMBA<D>(m.dom(), r.levels, 3, c, v2, mask, e);
     REQUIRE(got.size() == ref.size());
     for (std::size_t i = 0; i < got.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(ref[i], tol));
+    // (and at the same points unplanned, every 7th)
+    for (std::size_t i = 0; i < e.size(); i += 7)
+    {
+        double one[3];
+        m.evaluate(e[i].data(), one);
+        for (int j = 0; j < 3; ++j) REQUIRE_THAT(one[j], Catch::WithinAbs(ref[i*3 + j], tol));
+    }
     m.evaluateControl(got);
     const std::vector<double> refc = plainMBA<D>(m.dom(), r.levels, 3, c, v2, mask, c);
     for (std::size_t i = 0; i < got.size(); ++i) REQUIRE_THAT(got[i], Catch::WithinAbs(refc[i], tol));
@@ -289,7 +296,53 @@ void separatedLevels(bool masked)
     for (int j = 0; j < k - 2; ++j) CHECK(close[j].lonePoints == alonePoints<D>(dom, j, c));
 }
 
+/// Control points in a small cluster (sharing nodes down to fine levels)
+/// and a few far from it and from each other: lone from the coarse levels
+/// on, where the flat lattice holds their coefficients, to the fine ones,
+/// where their tiles hold nothing else. Their values, never stored,
+/// equal the plain method's at points near them and everywhere else.
+template <int D>
+void isolatedLonePoints(bool masked)
+{
+    std::vector<point<D>> c = randomPoints<D>(30, 61, 0.65, 0.7);
+    // three corners of the box, more than four level-3 cells (0.125) from
+    // the cluster and from each other along some direction
+    std::vector<point<D>> far(3);
+    for (std::size_t j = 0; j < far.size(); ++j)
+        for (int d = 0; d < D; ++d) far[j][d] = (j == 1 && d == 0) || (j == 2 && d == 1) ? 0.95 : 0.05;
+    c.insert(c.end(), far.begin(), far.end());
+    // 400 points in the unit box: the flat lattice is level 3 in 3D (its
+    // box of about 11^3 nodes is within the 4096 a small set gets, level
+    // 4's 19^3 is not) and level 5 in 2D (about 35^2; level 6: 66^2)
+    std::vector<point<D>> e = randomPoints<D>(400, 63);
+    for (const point<D>& x : far)
+        for (const point<D>& dx : randomPoints<D>(8, 64, -0.02, 0.02))
+        {
+            point<D> y = x;
+            for (int d = 0; d < D; ++d) y[d] += dx[d];
+            e.push_back(y);
+        }
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), 3) : std::vector<std::uint8_t>();
+    INFO("D " << D << ", masked " << masked);
+    const std::vector<levelStats> st = equalsPlainMBA<D>(c, mask, e);
+    const int flat = D == 3 ? 3 : 5;
+    REQUIRE(int(st.size()) > flat + 2);
+    CHECK(st[flat].lonePoints == std::int64_t(far.size()));
+    // a finer level holds no tile for the lone points' nodes alone
+    std::int64_t dropped = 0;
+    for (std::size_t k = flat + 1; k < st.size(); ++k)
+        if (st[k].lonePoints > 0) dropped += st[k].viewTiles*tileLayout<D>::nodesPerTile - st[k].nodes;
+    CHECK(dropped > 0);
+}
+
 } // namespace
+
+TEST_CASE("lone points' coefficients, not stored, equal the plain method's", "[core]")
+{
+    const bool masked = GENERATE(false, true);
+    isolatedLonePoints<2>(masked);
+    isolatedLonePoints<3>(masked);
+}
 
 TEST_CASE("the flat lattice holds a node a point up to 65536 nodes and one per 8 points beyond", "[core]")
 {
