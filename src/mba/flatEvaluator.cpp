@@ -301,7 +301,7 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     finerLevelPoints_.clear();
     finerLevelTiles_.clear();
     finerLonePairs_.clear();
-    finerLoneCounts_.clear();
+    finerEntries_.clear();
     std::vector<std::vector<std::uint8_t>> read(levels.size());
     for (int k = flatLevel_ + 1; k < nPlanned; ++k)
         if (levels[k].separated) read[k].assign(levels[k].view.size(), 0);
@@ -321,17 +321,23 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
             const std::size_t first = finerLonePairs_.size();
             forEachLoneOverlap(L, ctrl_, levelStencil<D>(eval_.u0[q], L.scale), tid, scratch,
                                [&](std::uint32_t j, double K) { finerLonePairs_.push_back({K, j}); });
-            precondition(finerLonePairs_.size() - first <= 0xffff, "mba: a point meets too many lone points");
-            finerLoneCounts_.push_back(std::uint16_t(finerLonePairs_.size() - first));
-            for (std::int32_t& id : tid) if (id >= L.storedTiles) id = -1;
-            finerLevelTiles_.push_back(tid);
+            const std::size_t nPairs = finerLonePairs_.size() - first;
+            precondition(nPairs < storedEntry, "mba: a point meets too many lone points");
+            bool stored = false;
+            for (std::int32_t& id : tid)
+            {
+                if (id >= L.storedTiles) id = -1;
+                stored = stored || id >= 0;
+            }
+            if (stored) finerLevelTiles_.push_back(tid);
+            finerEntries_.push_back(std::uint16_t(nPairs | (stored ? storedEntry : 0)));
         }
         if (m) finerLevelPoints_.emplace_back(std::uint32_t(q), m);
     }
     finerLevelPoints_.shrink_to_fit();
     finerLevelTiles_.shrink_to_fit();
     finerLonePairs_.shrink_to_fit();
-    finerLoneCounts_.shrink_to_fit();
+    finerEntries_.shrink_to_fit();
     return read;
 }
 
@@ -443,7 +449,7 @@ template <int D>
 void flatEvaluator<D>::addFinerLevels(const std::deque<levelPlan<D>>& levels, int nLevels, double* values) const
 {
     const stencilTiles<D>* tiles = finerLevelTiles_.data();
-    const std::uint16_t* nPairs = finerLoneCounts_.data();
+    const std::uint16_t* entry = finerEntries_.data();
     const lonePair* pair = finerLonePairs_.data();
     for (const auto& qm : finerLevelPoints_)
     {
@@ -453,15 +459,17 @@ void flatEvaluator<D>::addFinerLevels(const std::deque<levelPlan<D>>& levels, in
         for (std::uint32_t m = qm.second; m; m >>= 1, ++k)
         {
             if (!(m & 1)) continue;
+            const bool stored = *entry & storedEntry;
+            const lonePair* end = pair + (*entry++ & ~storedEntry);
             if (k < nLevels)
             {
                 const levelPlan<D>& L = levels[k];
-                evalStencil(L.phi.data(), nc_, *tiles, levelStencil<D>(eval_.u0[q], L.scale), v);
-                for (const lonePair* p = pair; p != pair + *nPairs; ++p)
+                if (stored) evalStencil(L.phi.data(), nc_, *tiles, levelStencil<D>(eval_.u0[q], L.scale), v);
+                for (const lonePair* p = pair; p != end; ++p)
                     for (int c = 0; c < nc_; ++c) v[c] += p->K*L.loneResiduals[p->j*nc_ + c];
             }
-            ++tiles;
-            pair += *nPairs++;
+            tiles += stored;
+            pair = end;
         }
     }
 }
@@ -472,7 +480,7 @@ std::int64_t flatEvaluator<D>::bytes() const
     return std::int64_t((flatPhi_.capacity() + refineScratch_.capacity() + sweptValues_.capacity())*sizeof(double)
         + finerLevelPoints_.capacity()*sizeof(finerLevelPoints_[0])
         + finerLevelTiles_.capacity()*sizeof(stencilTiles<D>)
-        + finerLonePairs_.capacity()*sizeof(lonePair) + finerLoneCounts_.capacity()*sizeof(std::uint16_t));
+        + finerLonePairs_.capacity()*sizeof(lonePair) + finerEntries_.capacity()*sizeof(std::uint16_t));
 }
 
 template class flatEvaluator<2>;

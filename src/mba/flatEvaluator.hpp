@@ -45,10 +45,17 @@ class flatEvaluator
     /// The evaluation points (positions in the sweep's order, ascending)
     /// where levels above flatLevel_ have coefficients at the point's
     /// stencil (a node with omega > 0; phi is 0 at the others), and those
-    /// levels: bit j for level flatLevel_ + 1 + j
+    /// levels: bit j for level flatLevel_ + 1 + j. Each (point, level) is
+    /// an "entry", point after point
     std::vector<std::pair<std::uint32_t, std::uint32_t>> finerLevelPoints_;
-    /// their stencils' stored tiles at those levels (-1 for the others:
-    /// levelPlan::storedTiles), point after point
+    /// Per entry: how many lone points its stencil meets (the low 15 bits:
+    /// its run of finerLonePairs_) and whether a tile of its stencil holds
+    /// coefficients (storedEntry: then its stencil's tiles are the next of
+    /// finerLevelTiles_; where only lone points' nodes are met, none is)
+    std::vector<std::uint16_t> finerEntries_;
+    static constexpr std::uint16_t storedEntry = 0x8000;
+    /// The stencils' tiles of the entries with storedEntry (-1 for those
+    /// that hold no coefficients: levelPlan::storedTiles)
     std::vector<stencilTiles<D>> finerLevelTiles_;
     /// A lone point (levelPlan::lone) j of a level whose nodes a stencil
     /// meets: it adds K times its loneResiduals there (forEachLoneOverlap)
@@ -57,8 +64,7 @@ class flatEvaluator
         double K;
         std::uint32_t j;
     };
-    std::vector<lonePair> finerLonePairs_;          ///< per entry of finerLevelTiles_, its lone points
-    std::vector<std::uint16_t> finerLoneCounts_;    ///< per entry of finerLevelTiles_, how many
+    std::vector<lonePair> finerLonePairs_;          ///< the entries' lone points, entry after entry
     std::pair<int, int> finerLevelsFoundFor_{-1, -1}; ///< (levels planned, flatLevel_) the two were found for
     /// evaluate()'s values in the sweep's (spatial) order, before they are
     /// put in the points' own order (a scratch array kept from call to call:
