@@ -253,12 +253,9 @@ void flatEvaluator<D>::addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b
         for (int d = 0; d < D; ++d) { nb.lo[d] = st.base[d]; nb.hi[d] = st.base[d] + 3; }
         const double* rr = &L.loneResiduals[j*nc_];
         forEachIndex<D>(nb, [&](const index<D>& n) {
+            if (!b.contains(n)) return;
             double w = 1;
-            for (int d = 0; d < D; ++d)
-            {
-                if (n[d] < b.lo[d] || n[d] > b.hi[d]) return;
-                w *= st.w[d][n[d] - st.base[d]];
-            }
+            for (int d = 0; d < D; ++d) w *= st.w[d][n[d] - st.base[d]];
             double* o = &flatPhi_[boxIndex<D>(b, n)*nc_];
             for (int c = 0; c < nc_; ++c) o[c] += w*rr[c];
         });
@@ -313,13 +310,14 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
         for (int k = flatLevel_ + 1; k < nPlanned; ++k)
         {
             const levelPlan<D>& L = levels[k];
+            const stencil<D> st = levelStencil<D>(eval_.u0[q], L.scale);
             double w[3];
-            if (!coefficientWeights(L, q, tid, w)) break;
+            if (!coefficientWeights(L, st, tid, w)) break;
             if (!(w[0] + w[1] + w[2] > 0)) continue;
             m |= std::uint32_t(1) << (k - flatLevel_ - 1);
             if (!read[k].empty()) for (const std::int32_t id : tid) if (id >= 0) read[k][id] = 1;
             const std::size_t first = finerLonePairs_.size();
-            forEachLoneOverlap(L, ctrl_, levelStencil<D>(eval_.u0[q], L.scale), tid, scratch,
+            forEachLoneOverlap(L, ctrl_, st, tid, scratch,
                                [&](std::uint32_t j, double K) { finerLonePairs_.push_back({K, j}); });
             const std::size_t nPairs = finerLonePairs_.size() - first;
             precondition(nPairs < storedEntry, "mba: a point meets too many lone points");
@@ -341,17 +339,16 @@ std::vector<std::vector<std::uint8_t>> flatEvaluator<D>::findFinerLevels(const s
     return read;
 }
 
-/// Whether a node of positive weight in the stencil at level L of the
-/// evaluation point at position q of the sweep has coefficients, per omega
+/// Whether a node of positive weight in the stencil st at level L (of an
+/// evaluation point, L.scale: levelStencil) has coefficients, per omega
 /// value (per component, or w[0] for all when a node holds one omega):
 /// w[j] is 1 where one has, else 0. False when no tile of L's view meets the
 /// stencil (nor does any finer level's: their nodes lie within the stencils
 /// of the same control points).
 template <int D>
-bool flatEvaluator<D>::coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid,
+bool flatEvaluator<D>::coefficientWeights(const levelPlan<D>& L, const stencil<D>& st, stencilTiles<D>& tid,
                                           double w[3]) const
 {
-    const stencil<D> st = levelStencil<D>(eval_.u0[q], L.scale);
     w[0] = w[1] = w[2] = 0;
     if (!findTiles(L.view, st, tid)) return false;
     const int per = ctrl_.omegaPerNode;
@@ -373,7 +370,7 @@ bool flatEvaluator<D>::reads(const levelPlan<D>& L) const
     double w[3];
     for (std::size_t q = 0; q < eval_.size(); ++q)
     {
-        if (!coefficientWeights(L, q, tid, w)) continue;
+        if (!coefficientWeights(L, levelStencil<D>(eval_.u0[q], L.scale), tid, w)) continue;
         const std::size_t i = eval_.at(q);
         for (int c = 0; c < nc_; ++c)
             if (w[ctrl_.omegaPerNode == 1 ? 0 : c] > 0 && eval_.reads(i, c)) return true;

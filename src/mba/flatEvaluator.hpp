@@ -78,7 +78,7 @@ class flatEvaluator
     void addTrend(const indexBox<D>& b, const trendLattice<D>& trend);
     void addAffine(const indexBox<D>& b, const affineFit<D>& affine);
     void addLevelInBox(const levelPlan<D>& L, const indexBox<D>& b);
-    bool coefficientWeights(const levelPlan<D>& L, std::size_t q, stencilTiles<D>& tid, double w[3]) const;
+    bool coefficientWeights(const levelPlan<D>& L, const stencil<D>& st, stencilTiles<D>& tid, double w[3]) const;
     std::vector<std::vector<std::uint8_t>> findFinerLevels(const std::deque<levelPlan<D>>& levels);
     void markReadEveryFit(std::deque<levelPlan<D>>& levels, std::vector<std::vector<std::uint8_t>>& read,
                           int nRanks) const;
