@@ -1,6 +1,7 @@
 // The planning of a level in the steps that levelPlanner::run() takes in
 // order (the query clusters and whom a rank asks for which tiles:
-// levelPlanRequests.cpp; the choice of the level's exchange:
+// levelPlanRequests.cpp; the points alone at their nodes:
+// levelPlanLone.cpp; the choice of the level's exchange:
 // levelPlanExchange.cpp).
 #include "levelPlanner.hpp"
 #include "collectively.hpp"
@@ -40,17 +41,24 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
         L_.stats.h = dom_.h0/L_.scale;
         return unreadLevel(L_);
     }
-    ownOmega();
+    // Serial and sparse, omega is formed only on the tiles that keep
+    // coefficients, once the lone points are known (on a fine level of a
+    // graded mesh most tiles hold only theirs); else up front, for the
+    // other ranks and the choice of exchange
+    const bool lateOmega = nRanks_ == 1 && !viewIsDense();
+    if (!lateOmega) ownOmega(ownIds_, nOwn_, [](std::int64_t id) { return id; });
     L_.tilesFrom.assign(nRanks_, {});
     keysFrom_.assign(nRanks_, {});
     omegaFrom_.assign(nRanks_, {});
     if (nRanks_ > 1) answerRequests();
     assembleView();
     findControlTiles();
+    findCoefficientNodes();
+    if (lateOmega) omegaWhereShared();
     testSeparation();
     if (!L_.separated) findLonePoints();
-    for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
-    findCoefficientNodes();
+    std::vector<std::uint64_t>().swap(multiNodes_);
+    std::vector<std::int32_t>().swap(omegaSlot_);
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
@@ -58,11 +66,16 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
                                                       : std::size_t(nodeCount(L_.nodesFrom[r])));
     if (nRanks_ > 1) chooseExchange();
     L_.storedTiles = L_.view.size();
-    if (!L_.separated && !L_.chunked && !L_.tree)
+    const bool plain = !L_.separated && !L_.chunked && !L_.tree;
+    if (plain && !L_.lone.empty() && !L_.view.dense()) storeLoneTilesLast();
+    if (lateOmega && !L_.separated)
     {
-        if (!L_.lone.empty() && !L_.view.dense()) storeLoneTilesLast();
-        findCoefficientRuns();
+        const std::int64_t n = L_.storedTiles;
+        ownOmega(L_.controlTiles, n, [n](std::int64_t id) { return id < n ? id : -1; });
+        L_.invOmega = std::move(ownOmega_);
     }
+    for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
+    if (plain) findCoefficientRuns();
     if (!L_.lone.empty()) indexLonePoints();
     precondition(L_.view.size() < (std::int64_t(1) << 31), "mba: more than 2^31 tiles in one level");
     if (L_.separated)
@@ -74,31 +87,6 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
     keepOmega();
     fillStats();
     return std::move(L_);
-}
-
-/// levelPlan::coefficientNodes: the nodes where omega, the ranks' partial
-/// sums (each >= 0) added, is > 0: where this rank's is (ownMask_) or a
-/// partial omega received from another rank is
-template <int D>
-void levelPlanner<D>::findCoefficientNodes()
-{
-    const int per = omegaPerNode_;
-    std::vector<std::uint64_t>& cn = L_.coefficientNodes;
-    if (L_.ownIsView) cn = ownMask_;
-    else
-    {
-        cn.assign(std::size_t(L_.view.size())*per, 0);
-        for (std::int64_t o = 0; o < nOwn_; ++o)
-            for (int j = 0; j < per; ++j) cn[ownToView_[o]*per + j] |= ownMask_[o*per + j];
-    }
-    for (int r = 0; r < nRanks_; ++r)
-    {
-        const std::vector<double>& og = omegaFrom_[r];
-        for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
-            for (int n = 0; n < npt; ++n)
-                for (int j = 0; j < per; ++j)
-                    if (og[(t*npt + n)*per + j] > 0) cn[L_.tilesFrom[r][t]*per + j] |= std::uint64_t(1) << n;
-    }
 }
 
 /// What the fits read of 1/omega after the plan: on plain levels runScales,
@@ -119,81 +107,6 @@ void levelPlanner<D>::keepOmega()
             to = std::copy(L_.invOmega.data() + r.first*per, L_.invOmega.data() + (r.first + r.second)*per, to);
     }
     hugeVector<double>().swap(L_.invOmega);
-}
-
-/// Numbers last the view tiles (sparse) that hold lone points' nodes alone,
-/// which then hold no phi (levelPlan::storedTiles): the tiles of the points
-/// that are not lone, and those that partial sums go to or come from, are
-/// kept first, in their order. Plain levels (the others' exchanges write
-/// their own tiles whole)
-template <int D>
-void levelPlanner<D>::storeLoneTilesLast()
-{
-    const std::int64_t n = L_.view.size();
-    std::vector<std::uint8_t> kept(n, 0);
-    for (std::size_t q = 0; q < L_.lone.size(); ++q)
-        if (!L_.lone[q]) for (const std::int32_t id : L_.controlTiles[q]) if (id >= 0) kept[id] = 1;
-    for (int r = 0; r < nRanks_; ++r)
-    {
-        for (const std::int64_t id : L_.tilesTo[r]) kept[id] = 1;
-        for (const std::int64_t id : L_.tilesFrom[r]) kept[id] = 1;
-    }
-    std::vector<std::int64_t> order(n), to(n);
-    for (std::int64_t id = 0; id < n; ++id) order[id] = id;
-    std::stable_partition(order.begin(), order.end(), [&](std::int64_t id) { return kept[id] != 0; });
-    L_.storedTiles = std::count(kept.begin(), kept.end(), std::uint8_t(1));
-    if (L_.storedTiles == n) return;
-    tileLayout<D> view;
-    view.init(nodes_, false);
-    for (std::int64_t t = 0; t < n; ++t) to[order[t]] = view.findOrInsertKey(L_.view.keyOf(order[t]));
-    L_.view = std::move(view);
-    // the arrays by tile id, in the new order: in place, cycle after cycle
-    // (1/omega is the plan's largest array while it is made)
-    std::vector<std::uint8_t> done(n);
-    const auto permute = [&](auto& v, std::size_t per) {
-        std::fill(done.begin(), done.end(), 0);
-        typename std::decay<decltype(v)>::type held(per);
-        for (std::int64_t first = 0; first < n; ++first)
-        {
-            if (done[first]) continue;
-            std::copy_n(&v[first*per], per, held.begin());
-            for (std::int64_t id = to[first]; ; id = to[id])
-            {
-                std::swap_ranges(held.begin(), held.end(), v.begin() + id*per);
-                done[id] = 1;
-                if (id == first) break;
-            }
-        }
-    };
-    permute(L_.coefficientNodes, std::size_t(omegaPerNode_));
-    permute(L_.invOmega, std::size_t(npt*omegaPerNode_));
-    permute(loneNodes_, std::size_t(npt));
-    for (stencilTiles<D>& tid : L_.controlTiles)
-        for (std::int32_t& id : tid) if (id >= 0) id = std::int32_t(to[id]);
-    for (auto* lists : {&L_.tilesTo, &L_.tilesFrom})
-        for (auto& tiles : *lists)
-            for (std::int64_t& id : tiles) id = to[id];
-    for (std::int64_t& id : L_.sharedWithLower) id = to[id];
-    for (std::int64_t& id : ownToView_) id = to[id];
-}
-
-/// levelPlan::lonePoints and the lone points of each view tile
-template <int D>
-void levelPlanner<D>::indexLonePoints()
-{
-    const std::size_t nt = std::size_t(L_.view.size());
-    for (std::size_t q = 0; q < L_.lone.size(); ++q)
-        if (L_.lone[q]) L_.lonePoints.push_back(std::uint32_t(q));
-    std::vector<std::uint32_t>& start = L_.loneTileStart;
-    start.assign(nt + 1, 0);
-    for (const std::uint32_t q : L_.lonePoints)
-        for (const std::int32_t id : L_.controlTiles[q]) if (id >= 0) ++start[id + 1];
-    for (std::size_t t = 0; t < nt; ++t) start[t + 1] += start[t];
-    L_.loneOnTile.resize(start[nt]);
-    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
-    for (std::uint32_t j = 0; j < L_.lonePoints.size(); ++j)
-        for (const std::int32_t id : L_.controlTiles[L_.lonePoints[j]]) if (id >= 0) L_.loneOnTile[at[id]++] = j;
-    L_.loneResiduals.assign(L_.lonePoints.size()*nc_, 0.0);
 }
 
 /// levelPlan::coefficientRuns from coefficientNodes, less the lone points'
@@ -224,7 +137,7 @@ void levelPlanner<D>::findCoefficientRuns()
 
 /// This rank's tiles, the tiles of each control point's stencil (found once:
 /// for omega, the ghosts and the fits) and the nodes where its partial
-/// omega is > 0 (ownMask_)
+/// omega is > 0 (ownMask_), with two or more points' w^2 (ownMulti_)
 template <int D>
 void levelPlanner<D>::ownTiles()
 {
@@ -233,6 +146,7 @@ void levelPlanner<D>::ownTiles()
     ownIds_.resize(ctrl_.order.size());
     const int per = omegaPerNode_;
     ownMask_.assign(std::size_t(nOwn_)*per, 0);
+    ownMulti_.assign(ownMask_.size(), 0);
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
         stencilTiles<D>& tid = ownIds_[pos++];
@@ -242,7 +156,12 @@ void levelPlanner<D>::ownTiles()
         {
             if (tid[t] < 0) continue;
             for (int c = 0; c < per; ++c)
-                if (per == 1 || ctrl_.mask[i*nc_ + c]) ownMask_[std::size_t(tid[t])*per + c] |= nodes[t];
+            {
+                if (per > 1 && !ctrl_.mask[i*nc_ + c]) continue;
+                const std::size_t j = std::size_t(tid[t])*per + c;
+                ownMulti_[j] |= ownMask_[j] & nodes[t];
+                ownMask_[j] |= nodes[t];
+            }
         }
     });
 }
@@ -311,28 +230,52 @@ bool levelPlanner<D>::readByEvaluation(const std::function<bool(const levelPlan<
     return read;
 }
 
-/// This rank's partial omega on its own tiles
+/// This rank's partial omega (ownOmega_) on nSlots tiles: the points'
+/// stencil tiles (tiles, in order) at slot(id), none where that is < 0
 template <int D>
-void levelPlanner<D>::ownOmega()
+template <class Slot>
+void levelPlanner<D>::ownOmega(const std::vector<stencilTiles<D>>& tiles, std::int64_t nSlots, Slot slot)
 {
     const int per = omegaPerNode_;
-    ownOmega_.assign(nOwn_*npt*per, 0.0);
+    ownOmega_.assign(nSlots*npt*per, 0.0);
     double* omega = ownOmega_.data();
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
         if (per == 1)
         {
-            detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
-                omega[id*npt + n] += w*w;
+            detail::visitStencil(tiles[pos++], st, [&](std::int64_t id, int n, double w) {
+                const std::int64_t s = slot(id);
+                if (s >= 0) omega[s*npt + n] += w*w;
             });
             return;
         }
         const std::uint8_t* m = &ctrl_.mask[i*nc_];
-        detail::visitStencil(ownIds_[pos++], st, [&](std::int64_t id, int n, double w) {
-            double* o = omega + (id*npt + n)*per;
+        detail::visitStencil(tiles[pos++], st, [&](std::int64_t id, int n, double w) {
+            const std::int64_t s = slot(id);
+            if (s < 0) return;
+            double* o = omega + (s*npt + n)*per;
             for (int c = 0; c < per; ++c) if (m[c]) o[c] += w*w;
         });
     });
+}
+
+/// Serial and sparse: omega (ownOmega_, omegaSlot_) on the tiles where two
+/// or more points' w^2 are > 0, the only nodes where aloneAtNodes needs
+/// its value (elsewhere it is a point's own w^2, or 0)
+template <int D>
+void levelPlanner<D>::omegaWhereShared()
+{
+    const int per = omegaPerNode_;
+    const std::int64_t n = L_.view.size();
+    omegaSlot_.assign(n, -1);
+    std::int32_t m = 0;
+    for (std::int64_t id = 0; id < n; ++id)
+    {
+        std::uint64_t shared = 0;
+        for (int c = 0; c < per; ++c) shared |= multiNodes_[id*per + c];
+        if (shared) omegaSlot_[id] = m++;
+    }
+    ownOmega(L_.controlTiles, m, [this](std::int64_t id) { return std::int64_t(omegaSlot_[id]); });
 }
 
 /// Of the own tiles other ranks asked for (tilesTo, asked_ from
@@ -433,16 +376,24 @@ std::vector<std::vector<double>> levelPlanner<D>::chooseGhosts()
     return gx;
 }
 
-/// The view: own and received tiles, dense when that is not much larger;
-/// tilesTo and tilesFrom as view ids, the own tiles shared with lower ranks
+/// Whether the view is dense: the level's box of tiles is not much more
+/// than the own and received tiles
 template <int D>
-void levelPlanner<D>::assembleView()
+bool levelPlanner<D>::viewIsDense() const
 {
     std::int64_t upper = nOwn_;
     for (const auto& kg : keysFrom_) upper += std::int64_t(kg.size());
     std::int64_t denseTiles = 1;
     for (int d = 0; d < D; ++d) denseTiles *= (nodes_[d] + tileEdge - 1)/tileEdge;
-    const bool dense = denseTiles <= 2*upper + 64;
+    return denseTiles <= 2*upper + 64;
+}
+
+/// The view: own and received tiles, dense when that is not much larger;
+/// tilesTo and tilesFrom as view ids, the own tiles shared with lower ranks
+template <int D>
+void levelPlanner<D>::assembleView()
+{
+    const bool dense = viewIsDense();
     if (nRanks_ == 1 && !dense)
     {
         // Serial and sparse: the own tiles and partial omega are the view
@@ -504,64 +455,6 @@ void levelPlanner<D>::findControlTiles()
     ctrl_.forEachStencil(L_.scale, [&](std::size_t, const stencil<D>& st) {
         findTiles(L_.view, st, L_.controlTiles[pos++]);
     });
-}
-
-/// Whether own point q (stencil st) is alone at every node of its stencil:
-/// in every component it constrains, omega (the sum over all ranks, not yet
-/// inverted) is its own w^2 alone, summed as the plan summed it (0 + w*w:
-/// exact), also at nodes where its weight is 0; with freeZero, omega is 0
-/// in the components it leaves free
-template <int D>
-bool levelPlanner<D>::aloneAtNodes(std::size_t q, const stencil<D>& st, bool freeZero) const
-{
-    const std::size_t i = ctrl_.order[q];
-    bool alone = true;
-    detail::visitStencil(L_.controlTiles[q], st, [&](std::int64_t id, int n, double w) {
-        const double* o = &L_.invOmega[(id*npt + n)*omegaPerNode_];
-        for (int c = 0; c < omegaPerNode_; ++c)
-        {
-            const bool constrained = omegaPerNode_ == 1 || ctrl_.mask[i*nc_ + c];
-            if (constrained || freeZero) alone = alone && o[c] == (constrained ? w*w : 0.0);
-        }
-    });
-    return alone;
-}
-
-/// Separated: every own point of every rank is alone at its nodes in the
-/// components it constrains (a coarse level fails at its first points)
-template <int D>
-void levelPlanner<D>::testSeparation()
-{
-    bool alone = true;
-    for (std::size_t q = 0; q < ctrl_.order.size() && alone; ++q) alone = aloneAtNodes(q, ctrl_.stencilAt(q, L_.scale), false);
-    L_.separated = comm_.max(alone ? 0.0 : 1.0) == 0;
-}
-
-/// levelPlan::lone, from omega (before it is inverted). Empty when no point
-/// is lone
-template <int D>
-void levelPlanner<D>::findLonePoints()
-{
-    const std::size_t nq = ctrl_.order.size();
-    std::vector<std::uint8_t> read(nRanks_ > 1 ? L_.view.size() : 0, 0);
-    for (const auto& tiles : L_.tilesTo)
-        for (const std::int64_t id : tiles) read[id] = 1;
-    std::vector<stencil<D>> st(nq);
-    for (std::size_t q = 0; q < nq; ++q) st[q] = ctrl_.stencilAt(q, L_.scale);
-    L_.lone.assign(nq, 0);
-    loneNodes_.clear();
-    for (std::size_t q = 0; q < nq; ++q)
-    {
-        if ((q > 0 && st[q - 1].base == st[q].base) || (q + 1 < nq && st[q + 1].base == st[q].base)) continue;
-        bool alone = true;
-        for (const std::int32_t id : L_.controlTiles[q]) alone = alone && !(id >= 0 && !read.empty() && read[id]);
-        alone = alone && aloneAtNodes(q, st[q], true);
-        L_.lone[q] = alone;
-        if (!alone) continue;
-        loneNodes_.resize(std::size_t(L_.view.size())*npt, 0);
-        detail::visitStencil(L_.controlTiles[q], st[q], [&](std::int64_t id, int n, double) { loneNodes_[id*npt + n] = 1; });
-    }
-    if (loneNodes_.empty()) L_.lone.clear();
 }
 
 /// The ghosts' stencil tiles, numbered as the tiles received from their rank

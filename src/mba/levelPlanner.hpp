@@ -1,7 +1,7 @@
 // bsplineMorph: OpenFOAM-free multilevel B-spline core (internal header)
-// The planner of one level (levelPlan.cpp: the steps of run(); the choice of
-// the level's exchange, chooseExchange() and what it uses:
-// levelPlanExchange.cpp).
+// The planner of one level (levelPlan.cpp: the steps of run(); the points
+// alone at their nodes: levelPlanLone.cpp; the choice of the level's
+// exchange, chooseExchange() and what it uses: levelPlanExchange.cpp).
 #ifndef MBA_LEVELPLANNER_HPP
 #define MBA_LEVELPLANNER_HPP
 
@@ -36,7 +36,20 @@ class levelPlanner
     /// omega is > 0 (bit n: node n), where a weight w of a point it holds
     /// has w^2 > 0
     std::vector<std::uint64_t> ownMask_;
-    hugeVector<double> ownOmega_;       ///< this rank's partial omega on its own tiles (may become the view's)
+    /// the same where two or more of its points' w^2 are > 0
+    std::vector<std::uint64_t> ownMulti_;
+    /// per view tile and omega value: the nodes where two or more points
+    /// of all ranks have w^2 > 0 (as coefficientNodes where one or more
+    /// have), until the lone points are found
+    std::vector<std::uint64_t> multiNodes_;
+    /// this rank's partial omega on its own tiles (may become the view's);
+    /// serially on a sparse level, first where omegaSlot_ says, then on the
+    /// stored tiles (ownOmega())
+    hugeVector<double> ownOmega_;
+    /// serial and sparse, while the lone points are found: per view tile
+    /// its omega's place in ownOmega_ (-1: none), formed only where two or
+    /// more points' w^2 are > 0 (empty: omega is L_.invOmega, not inverted)
+    std::vector<std::int32_t> omegaSlot_;
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
     std::vector<std::int64_t> ownToView_;              ///< own tile id -> view id (parallel)
@@ -52,7 +65,16 @@ class levelPlanner
     void ownTiles();
     void findAskedTiles(const std::vector<std::vector<std::uint64_t>>& wanted);
     bool readByEvaluation(const std::function<bool(const levelPlan<D>&)>& isRead);
-    void ownOmega();
+    bool viewIsDense() const;
+    template <class Slot>
+    void ownOmega(const std::vector<stencilTiles<D>>& tiles, std::int64_t nSlots, Slot slot);
+    void omegaWhereShared();
+    /// omega at view tile id's nodes (not inverted), where aloneAtNodes reads it
+    const double* omegaAt(std::int64_t id) const
+    {
+        const std::int64_t at = omegaSlot_.empty() ? id : omegaSlot_[id];
+        return (omegaSlot_.empty() ? L_.invOmega.data() : ownOmega_.data()) + at*npt*omegaPerNode_;
+    }
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
     std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;

@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <numeric>
 
 using namespace mba;
@@ -227,6 +228,60 @@ TEST_CASE("levels that separate all or most control points: serial equals simula
         std::int64_t lone = 0;
         for (int r = 0; r < P; ++r) lone += st[r][finest].lonePoints;
         if (close && how == partition::slabs) CHECK(lone > std::int64_t(c.size())/4);
+    }
+}
+
+TEST_CASE("a weight whose square vanishes in omega's sum leaves a point lone: serial equals simulated ranks",
+          "[parallel]")
+{
+    // At level 5, p's last node along x is q's first, where q's weight is
+    // (1e-6)^3/6: omega there sums to p's w^2 alone, so p is lone (its part
+    // of the level, w r/sum(w^2), is what the plain method gives) and q is
+    // not; two corners fix the domain and are lone too. Serially omega is
+    // formed only where two points' w^2 are > 0 until the lone points are
+    // known, on several ranks up front: the same values either way.
+    const int k = 5;
+    std::vector<point<3>> c = {{{0, 0, 0}}, {{1, 1, 1}}};
+    problem pb;
+    pb.p.affine = false;
+    pb.p.tolerance = 1e-13;
+    pb.p.maxLevels = 14;
+    const std::vector<std::uint8_t> all;
+    domain<3> dom = multilevel<3>(serial(), pb.p, pb.nc, c, all, c).dom();
+    const auto at = [&](double ux, double u) {   // (level-k coordinates)
+        point<3> x;
+        for (int d = 0; d < 3; ++d) x[d] = dom.lo[d] + (d == 0 ? ux : u)*dom.h0/std::ldexp(1.0, k);
+        return x;
+    };
+    c.push_back(at(10.5, 10.5));
+    c.push_back(at(14 - 1e-6, 10.5));
+    std::vector<point<3>> e;
+    for (const point<3>& dx : randomPoints<3>(300, 81, -0.05, 0.05))
+    {
+        point<3> x = c[2 + e.size() % 2];
+        for (int d = 0; d < 3; ++d) x[d] += dx[d];
+        e.push_back(x);
+    }
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    std::vector<std::vector<levelStats>> st(3);
+    std::vector<fitReport> rep(3);
+    pb.stats = &st;
+    pb.reports = &rep;
+    const std::vector<double> ref = solve<3>(1, partition::slabs, c, v, all, e, pb);
+    REQUIRE(rep[0].converged);
+    REQUIRE(rep[0].levels > k);
+    CHECK(st[0][k].lonePoints == 3);
+    CHECK_FALSE(st[0][k].separated);
+    const std::vector<double> plain = plainMBA<3>(dom, rep[0].levels, pb.nc, c, v, all, e);
+    const double tol = 1e-12*maxAbs(v);
+    for (std::size_t i = 0; i < ref.size(); ++i) REQUIRE_THAT(ref[i], Catch::WithinAbs(plain[i], tol));
+    for (int P : {2, 3})
+    {
+        INFO("ranks " << P);
+        const std::vector<double> got = solve<3>(P, partition::slabs, c, v, all, e, pb);
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+        CHECK(diff <= tol);
     }
 }
 
