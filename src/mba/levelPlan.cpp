@@ -59,6 +59,7 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
     if (!L_.separated) findLonePoints();
     std::vector<std::uint64_t>().swap(multiNodes_);
     std::vector<std::int32_t>().swap(omegaSlot_);
+    if (lateOmega) hugeVector<double>().swap(ownOmega_);   // (omega where shared, read by the lone test only)
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
@@ -114,12 +115,9 @@ void levelPlanner<D>::keepOmega()
 template <int D>
 void levelPlanner<D>::findCoefficientRuns()
 {
-    const int per = omegaPerNode_;
     const std::int64_t nNodes = L_.storedTiles*npt;
     const auto coefficient = [&](std::int64_t n) {
-        std::uint64_t any = 0;
-        for (int j = 0; j < per; ++j) any |= L_.coefficientNodes[(n/npt)*per + j];
-        return (any >> (n % npt) & 1) != 0;
+        return (anyValue(L_.coefficientNodes, n/npt) >> (n % npt) & 1) != 0;
     };
     auto& runs = L_.coefficientRuns;
     for (std::int64_t n = 0; n < nNodes; ++n)
@@ -265,16 +263,11 @@ void levelPlanner<D>::ownOmega(const std::vector<stencilTiles<D>>& tiles, std::i
 template <int D>
 void levelPlanner<D>::omegaWhereShared()
 {
-    const int per = omegaPerNode_;
     const std::int64_t n = L_.view.size();
     omegaSlot_.assign(n, -1);
     std::int32_t m = 0;
     for (std::int64_t id = 0; id < n; ++id)
-    {
-        std::uint64_t shared = 0;
-        for (int c = 0; c < per; ++c) shared |= multiNodes_[id*per + c];
-        if (shared) omegaSlot_[id] = m++;
-    }
+        if (anyValue(multiNodes_, id)) omegaSlot_[id] = m++;
     ownOmega(L_.controlTiles, m, [this](std::int64_t id) { return std::int64_t(omegaSlot_[id]); });
 }
 
@@ -290,7 +283,7 @@ void levelPlanner<D>::answerRequests()
     const int blk = npt*omegaPerNode_;
     for (int r = 0; r < nRanks_; ++r)
         for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
-            L_.nodesTo[r].push_back(asked_[r][j] & ownNodes(L_.tilesTo[r][j]));
+            L_.nodesTo[r].push_back(asked_[r][j] & anyValue(ownMask_, L_.tilesTo[r][j]));
     const std::vector<std::vector<double>> gx = chooseGhosts();
     std::vector<std::vector<std::uint64_t>> answer(nRanks_);
     std::vector<std::vector<double>> om(nRanks_);

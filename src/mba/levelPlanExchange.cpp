@@ -65,7 +65,7 @@ void levelPlanner<D>::considerTree()
     std::int64_t ownValues = 0;
     for (std::int64_t o = 0; o < nOwn_; ++o)
     {
-        const std::uint64_t nodes = ownNodes(o);
+        const std::uint64_t nodes = anyValue(ownMask_, o);
         if (!nodes) continue;
         mine.push_back(L_.view.keyOf(ownToView_[o]));
         mine.push_back(nodes);

@@ -90,12 +90,13 @@ class levelPlanner
     void indexLonePoints();
     void findGhostTiles();
     void chooseExchange();
-    /// The nodes of own tile o where this rank's partial omega is > 0 (bit
-    /// n: node n): where its partial sums can be other than 0
-    std::uint64_t ownNodes(std::int64_t o) const
+    /// The nodes of tile id set in any of its omega values' masks (masks:
+    /// omegaPerNode_ a tile, bit n: node n); of ownMask_, where this rank's
+    /// partial omega is > 0: where its partial sums can be other than 0
+    std::uint64_t anyValue(const std::vector<std::uint64_t>& masks, std::int64_t id) const
     {
         std::uint64_t nodes = 0;
-        for (int c = 0; c < omegaPerNode_; ++c) nodes |= ownMask_[o*omegaPerNode_ + c];
+        for (int c = 0; c < omegaPerNode_; ++c) nodes |= masks[id*omegaPerNode_ + c];
         return nodes;
     }
     void findCoefficientNodes();
