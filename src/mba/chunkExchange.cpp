@@ -146,12 +146,9 @@ chunkExchange planChunks(const chunkSources<D>& in)
     // sums where its partial omega is (each side knows it: the plan sent
     // it), of the sums where the sum of omega is (every reader has it)
     const int per = in.omegaPerNode;
-    auto anyPositive = [per](const double* o) {
-        for (int c = 0; c < per; ++c) if (o[c] > 0) return true;
-        return false;
-    };
-    auto partialOmega = [&](int r, std::int64_t w, int n) {
-        return r == in.me ? &in.ownOmega[(w*npt + n)*per] : &in.omegaFrom[r][(w*npt + n)*per];
+    // the nodes of tile w (own id, or place in tilesFrom) where rank r's partial omega is > 0
+    auto partialNodes = [&](int r, std::int64_t w) {
+        return anyValue(r == in.me ? in.ownMask : in.maskFrom[r], w, per);
     };
     chunkExchange X;
     X.partialTo.assign(in.nRanks, {});
@@ -170,8 +167,11 @@ chunkExchange planChunks(const chunkSources<D>& in)
         const std::size_t words = std::size_t((m + 63)/64);
         reach.assign(npt*words, 0);
         for (std::int64_t c = 0; c < m; ++c)
+        {
+            const std::uint64_t nodes = partialNodes(C[c], W[c]);
             for (int n = 0; n < npt; ++n)
-                if (anyPositive(partialOmega(C[c], W[c], n))) reach[n*words + c/64] |= std::uint64_t(1) << (c % 64);
+                if (nodes >> n & 1) reach[n*words + c/64] |= std::uint64_t(1) << (c % 64);
+        }
         return words;
     };
     // this rank's load, which no owner changes: the nodes it reads that
@@ -199,7 +199,8 @@ chunkExchange planChunks(const chunkSources<D>& in)
         const int* C = &T.contributors[T.cBegin[id]];
         const std::int64_t m = T.cBegin[id + 1] - T.cBegin[id];
         const std::int64_t self = std::find(C, C + m, in.me) - C;   // m: not a contributor
-        const auto summed = [&](int n) { return anyPositive(&in.invOmega[(id*npt + n)*per]); };
+        const std::uint64_t summedHere = anyValue(in.summedNodes, id, per);
+        const auto summed = [&](int n) { return (summedHere >> n & 1) != 0; };
         const auto readHere = [&](int n) { return (in.read[id] >> n & 1) != 0 && summed(n); };
         std::size_t words = 0;
         if (m == 1) by.assign(npt, 0);

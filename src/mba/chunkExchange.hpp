@@ -86,9 +86,12 @@ struct chunkSources
     const std::vector<std::vector<std::int64_t>>& tilesTo;   ///< per rank: the own tiles it reads
     const std::vector<std::vector<std::uint64_t>>& readTo;   ///< per rank: the nodes it reads of each (bit n: node n)
     const std::vector<std::uint64_t>& read;                  ///< per view tile: the nodes this rank reads
-    const hugeVector<double>& ownOmega;                      ///< this rank's partial omega (own ids)
-    const std::vector<std::vector<double>>& omegaFrom;       ///< per rank: its partial omega on tilesFrom's tiles
-    const hugeVector<double>& invOmega;                      ///< 1/omega on the view (> 0 where omega is)
+    /// per own tile and omega value: the nodes where this rank's partial omega is > 0 (bit n: node n)
+    const std::vector<std::uint64_t>& ownMask;
+    /// per rank: the same on tilesFrom's tiles
+    const std::vector<std::vector<std::uint64_t>>& maskFrom;
+    /// per view tile and omega value: the nodes where omega is > 0 (bit n: node n)
+    const std::vector<std::uint64_t>& summedNodes;
     /// the ranks (planChunks gathers each rank's load on the level through it)
     const communicator& comm;
 };

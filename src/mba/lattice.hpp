@@ -200,6 +200,15 @@ inline std::int64_t nodeCount(const std::vector<std::uint64_t>& tiles)
     return n;
 }
 
+/// The nodes of tile id set in any of its per values' masks (masks: per a
+/// tile, bit n: node n)
+inline std::uint64_t anyValue(const std::vector<std::uint64_t>& masks, std::int64_t id, int per)
+{
+    std::uint64_t nodes = 0;
+    for (int c = 0; c < per; ++c) nodes |= masks[std::size_t(id*per + c)];
+    return nodes;
+}
+
 /// f(n) for each node n in a tile's node bits, in ascending order
 template <class F>
 void forEachNode(std::uint64_t nodes, F f)

@@ -41,25 +41,25 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
         L_.stats.h = dom_.h0/L_.scale;
         return unreadLevel(L_);
     }
-    // Serial and sparse, omega is formed only on the tiles that keep
-    // coefficients, once the lone points are known (on a fine level of a
-    // graded mesh most tiles hold only theirs); else up front, for the
-    // other ranks and the choice of exchange
-    const bool lateOmega = nRanks_ == 1 && !viewIsDense();
-    if (!lateOmega) ownOmega(ownIds_, nOwn_, [](std::int64_t id) { return id; });
+    // omega is formed only where it is read: this rank's partial sums on the
+    // tiles other ranks ask for (answerRequests), the sums where two or more
+    // points meet (the lone test), then on the tiles that keep coefficients
+    // (on a fine level of a graded mesh most tiles hold only lone points')
     L_.tilesFrom.assign(nRanks_, {});
     keysFrom_.assign(nRanks_, {});
     omegaFrom_.assign(nRanks_, {});
+    maskFrom_.assign(nRanks_, {});
     if (nRanks_ > 1) answerRequests();
     assembleView();
     findControlTiles();
     findCoefficientNodes();
-    if (lateOmega) omegaWhereShared();
+    omegaWhereShared();
     testSeparation();
     if (!L_.separated) findLonePoints();
     std::vector<std::uint64_t>().swap(multiNodes_);
     std::vector<std::int32_t>().swap(omegaSlot_);
-    if (lateOmega) hugeVector<double>().swap(ownOmega_);   // (omega where shared, read by the lone test only)
+    // (a dense view's omega is formed on every tile for the lone test, and kept)
+    if (L_.separated || !L_.view.dense()) hugeVector<double>().swap(omega_);
     findGhostTiles();
     L_.receiveCounts.assign(nRanks_, 0);
     for (int r = 0; r < nRanks_ && nRanks_ > 1; ++r)
@@ -69,11 +69,11 @@ levelPlan<D> levelPlanner<D>::run(int k, const std::function<bool(const levelPla
     L_.storedTiles = L_.view.size();
     const bool plain = !L_.separated && !L_.chunked && !L_.tree;
     if (plain && !L_.lone.empty() && !L_.view.dense()) storeLoneTilesLast();
-    if (lateOmega && !L_.separated)
+    if (!L_.separated)
     {
         const std::int64_t n = L_.storedTiles;
-        ownOmega(L_.controlTiles, n, [n](std::int64_t id) { return id < n ? id : -1; });
-        L_.invOmega = std::move(ownOmega_);
+        if (!L_.view.dense()) formOmega(n, [n](std::int64_t id) { return id < n ? id : -1; });
+        L_.invOmega = std::move(omega_);
     }
     for (double& o : L_.invOmega) o = o > 0 ? 1/o : 0.0;
     if (plain) findCoefficientRuns();
@@ -228,15 +228,15 @@ bool levelPlanner<D>::readByEvaluation(const std::function<bool(const levelPlan<
     return read;
 }
 
-/// This rank's partial omega (ownOmega_) on nSlots tiles: the points'
-/// stencil tiles (tiles, in order) at slot(id), none where that is < 0
+/// This rank's partial omega (omega_) on nSlots tiles: the points' stencil
+/// tiles (tiles, in order) at slot(id), none where that is < 0
 template <int D>
 template <class Slot>
 void levelPlanner<D>::ownOmega(const std::vector<stencilTiles<D>>& tiles, std::int64_t nSlots, Slot slot)
 {
     const int per = omegaPerNode_;
-    ownOmega_.assign(nSlots*npt*per, 0.0);
-    double* omega = ownOmega_.data();
+    omega_.assign(nSlots*npt*per, 0.0);
+    double* omega = omega_.data();
     std::size_t pos = 0;
     ctrl_.forEachStencil(L_.scale, [&](std::size_t i, const stencil<D>& st) {
         if (per == 1)
@@ -257,9 +257,47 @@ void levelPlanner<D>::ownOmega(const std::vector<stencilTiles<D>>& tiles, std::i
     });
 }
 
-/// Serial and sparse: omega (ownOmega_, omegaSlot_) on the tiles where two
-/// or more points' w^2 are > 0, the only nodes where aloneAtNodes needs
-/// its value (elsewhere it is a point's own w^2, or 0)
+/// omega (omega_, not inverted) on nSlots view tiles, at slot(id) of view
+/// tile id (none where that is < 0): the ranks' partial sums added in rank
+/// order, each formed from 0 (every rank holding a tile adds the same terms
+/// in the same order)
+template <int D>
+template <class Slot>
+void levelPlanner<D>::formOmega(std::int64_t nSlots, Slot slot)
+{
+    ownOmega(L_.controlTiles, nSlots, slot);
+    if (nRanks_ == 1) return;
+    const std::int64_t blk = npt*omegaPerNode_;
+    // the lower ranks' sum, where they have partial sums, before this rank's
+    std::vector<std::int32_t> lowerAt(nSlots, -1);
+    std::vector<double> lower;
+    for (int r = 0; r < me_; ++r)
+        for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
+        {
+            const std::int64_t s = slot(L_.tilesFrom[r][t]);
+            if (s < 0) continue;
+            if (lowerAt[s] < 0)
+            {
+                lowerAt[s] = std::int32_t(lower.size()/blk);
+                lower.resize(lower.size() + blk, 0.0);
+            }
+            for (std::int64_t j = 0; j < blk; ++j) lower[lowerAt[s]*blk + j] += omegaFrom_[r][t*blk + j];
+        }
+    for (std::int64_t s = 0; s < nSlots; ++s)
+        if (lowerAt[s] >= 0)
+            for (std::int64_t j = 0; j < blk; ++j) omega_[s*blk + j] = lower[lowerAt[s]*blk + j] + omega_[s*blk + j];
+    for (int r = me_ + 1; r < nRanks_; ++r)
+        for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
+        {
+            const std::int64_t s = slot(L_.tilesFrom[r][t]);
+            if (s >= 0) for (std::int64_t j = 0; j < blk; ++j) omega_[s*blk + j] += omegaFrom_[r][t*blk + j];
+        }
+}
+
+/// omega (omega_, omegaSlot_) on the view tiles where two or more points'
+/// w^2 are > 0, the only nodes where aloneAtNodes needs its value
+/// (elsewhere it is a point's own w^2, or 0); on a dense view on all tiles
+/// (every tile is stored)
 template <int D>
 void levelPlanner<D>::omegaWhereShared()
 {
@@ -267,8 +305,8 @@ void levelPlanner<D>::omegaWhereShared()
     omegaSlot_.assign(n, -1);
     std::int32_t m = 0;
     for (std::int64_t id = 0; id < n; ++id)
-        if (anyValue(multiNodes_, id)) omegaSlot_[id] = m++;
-    ownOmega(L_.controlTiles, m, [this](std::int64_t id) { return std::int64_t(omegaSlot_[id]); });
+        if (L_.view.dense() || anyValue(multiNodes_, id)) omegaSlot_[id] = m++;
+    formOmega(m, [this](std::int64_t id) { return std::int64_t(omegaSlot_[id]); });
 }
 
 /// Of the own tiles other ranks asked for (tilesTo, asked_ from
@@ -285,6 +323,12 @@ void levelPlanner<D>::answerRequests()
         for (std::size_t j = 0; j < L_.tilesTo[r].size(); ++j)
             L_.nodesTo[r].push_back(asked_[r][j] & anyValue(ownMask_, L_.tilesTo[r][j]));
     const std::vector<std::vector<double>> gx = chooseGhosts();
+    // this rank's partial omega on the tiles asked for (at asked[id])
+    std::vector<std::int64_t> asked(nOwn_, -1);
+    std::int64_t nAsked = 0;
+    for (const auto& tiles : L_.tilesTo)
+        for (const std::int64_t id : tiles) if (asked[id] < 0) asked[id] = nAsked++;
+    ownOmega(ownIds_, nAsked, [&asked](std::int64_t id) { return asked[id]; });
     std::vector<std::vector<std::uint64_t>> answer(nRanks_);
     std::vector<std::vector<double>> om(nRanks_);
     for (int r = 0; r < nRanks_; ++r)
@@ -295,9 +339,10 @@ void levelPlanner<D>::answerRequests()
         {
             const std::int64_t id = L_.tilesTo[r][j];
             answer[r].insert(answer[r].end(), {L_.ownLayout.keyOf(id), L_.nodesTo[r][j]});
-            om[r].insert(om[r].end(), ownOmega_.begin() + id*blk, ownOmega_.begin() + (id + 1)*blk);
+            om[r].insert(om[r].end(), omega_.begin() + asked[id]*blk, omega_.begin() + (asked[id] + 1)*blk);
         }
     }
+    hugeVector<double>().swap(omega_);
     const std::vector<std::vector<std::uint64_t>> got = comm_.exchange(answer);
     L_.byGhostsFrom.assign(nRanks_, 0);
     L_.nodesFrom.assign(nRanks_, {});
@@ -312,6 +357,16 @@ void levelPlanner<D>::answerRequests()
         }
     }
     omegaFrom_ = comm_.exchange(om);
+    const int per = omegaPerNode_;
+    maskFrom_.assign(nRanks_, {});
+    for (int r = 0; r < nRanks_; ++r)
+        for (std::size_t j = 0; j < omegaFrom_[r].size()/npt; ++j)   // (per tile and omega value)
+        {
+            const std::size_t t = j/per, c = j % per;
+            std::uint64_t nodes = 0;
+            for (int n = 0; n < npt; ++n) if (omegaFrom_[r][(t*npt + n)*per + c] > 0) nodes |= std::uint64_t(1) << n;
+            maskFrom_[r].push_back(nodes);
+        }
     L_.ghostsFrom = comm_.exchange(gx);
 }
 
@@ -389,11 +444,10 @@ void levelPlanner<D>::assembleView()
     const bool dense = viewIsDense();
     if (nRanks_ == 1 && !dense)
     {
-        // Serial and sparse: the own tiles and partial omega are the view
+        // Serial and sparse: the own tiles are the view
         L_.view = std::move(L_.ownLayout);
         L_.ownLayout = tileLayout<D>();
         L_.ownIsView = true;
-        L_.invOmega = std::move(ownOmega_);
         return;
     }
     L_.view.init(nodes_, dense);
@@ -409,29 +463,6 @@ void levelPlanner<D>::assembleView()
     for (int r = 0; r < me_; ++r)
         for (auto id : L_.tilesFrom[r])
             if (shared[id] == 1) { shared[id] = 2; L_.sharedWithLower.push_back(id); }
-    sumOmega(ownToView);
-}
-
-/// omega on the view: the ranks' partial sums added in rank order
-template <int D>
-void levelPlanner<D>::sumOmega(const std::vector<std::int64_t>& ownToView)
-{
-    const int blk = npt*omegaPerNode_;
-    L_.invOmega.assign(L_.view.size()*blk, 0.0);
-    for (int r = 0; r < nRanks_; ++r)
-    {
-        if (r == me_)
-        {
-            for (std::int64_t id = 0; id < nOwn_; ++id)
-                for (int j = 0; j < blk; ++j) L_.invOmega[ownToView[id]*blk + j] += ownOmega_[id*blk + j];
-        }
-        else
-        {
-            const auto& og = omegaFrom_[r];
-            for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
-                for (int j = 0; j < blk; ++j) L_.invOmega[L_.tilesFrom[r][t]*blk + j] += og[t*blk + j];
-        }
-    }
 }
 
 /// The view tiles of the own control points' stencils

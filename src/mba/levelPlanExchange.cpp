@@ -28,7 +28,7 @@ void levelPlanner<D>::chooseExchange()
                 if (id >= 0) read[id] |= q[j + 1];
             }
         chunkExchange X = planChunks<D>(chunkSources<D>{nRanks_, me_, nc_, omegaPerNode_, L_.view, ownToView_,
-            L_.tilesFrom, L_.tilesTo, asked_, read, ownOmega_, omegaFrom_, L_.invOmega, comm_});
+            L_.tilesFrom, L_.tilesTo, asked_, read, ownMask_, maskFrom_, L_.coefficientNodes, comm_});
         bool take = true;
         if (mode_ == params::exchangeMode::automatic)
         {

@@ -11,9 +11,9 @@
 namespace mba {
 
 /// levelPlan::coefficientNodes: the nodes where omega, the ranks' partial
-/// sums (each >= 0) added, is > 0: where this rank's is (ownMask_) or a
-/// partial omega received from another rank is; and multiNodes_, where two
-/// or more points' w^2 are (ownMulti_, or more than one of those sums)
+/// sums (each >= 0) added, is > 0: where this rank's is (ownMask_) or
+/// another rank's is (maskFrom_); and multiNodes_, where two or more
+/// points' w^2 are (ownMulti_, or more than one of those sums)
 template <int D>
 void levelPlanner<D>::findCoefficientNodes()
 {
@@ -36,18 +36,14 @@ void levelPlanner<D>::findCoefficientNodes()
             }
     }
     for (int r = 0; r < nRanks_; ++r)
-    {
-        const std::vector<double>& og = omegaFrom_[r];
         for (std::size_t t = 0; t < L_.tilesFrom[r].size(); ++t)
             for (int j = 0; j < per; ++j)
             {
-                std::uint64_t from = 0;
-                for (int n = 0; n < npt; ++n) if (og[(t*npt + n)*per + j] > 0) from |= std::uint64_t(1) << n;
+                const std::uint64_t from = maskFrom_[r][t*per + j];
                 const std::size_t at = std::size_t(L_.tilesFrom[r][t])*per + j;
                 multiNodes_[at] |= cn[at] & from;
                 cn[at] |= from;
             }
-    }
 }
 
 /// Numbers last the view tiles (sparse) that hold lone points' nodes alone,
@@ -77,8 +73,7 @@ void levelPlanner<D>::storeLoneTilesLast()
     for (std::int64_t t = 0; t < n; ++t) to[order[t]] = view.findOrInsertKey(L_.view.keyOf(order[t]));
     L_.view = std::move(view);
     // the arrays by tile id, in the new order: in place, cycle after cycle
-    // (on several ranks 1/omega is the plan's largest array while it is
-    // made; serially it is formed after this, on the stored tiles)
+    // (omega is formed after this, on the stored tiles)
     std::vector<std::uint8_t> done(n);
     const auto permute = [&](auto& v, std::size_t per) {
         if (v.empty()) return;
@@ -97,7 +92,6 @@ void levelPlanner<D>::storeLoneTilesLast()
         }
     };
     permute(L_.coefficientNodes, std::size_t(omegaPerNode_));
-    permute(L_.invOmega, std::size_t(npt*omegaPerNode_));
     permute(loneNodes_, std::size_t(npt));
     for (stencilTiles<D>& tid : L_.controlTiles)
         for (std::int32_t& id : tid) if (id >= 0) id = std::int32_t(to[id]);

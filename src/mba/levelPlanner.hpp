@@ -42,16 +42,18 @@ class levelPlanner
     /// of all ranks have w^2 > 0 (as coefficientNodes where one or more
     /// have), until the lone points are found
     std::vector<std::uint64_t> multiNodes_;
-    /// this rank's partial omega on its own tiles (may become the view's);
-    /// serially on a sparse level, first where omegaSlot_ says, then on the
-    /// stored tiles (ownOmega())
-    hugeVector<double> ownOmega_;
-    /// serial and sparse, while the lone points are found: per view tile
-    /// its omega's place in ownOmega_ (-1: none), formed only where two or
-    /// more points' w^2 are > 0 (empty: omega is L_.invOmega, not inverted)
+    /// omega, not inverted, at the slots that formOmega() was given: where
+    /// aloneAtNodes reads it (omegaSlot_), then on the stored tiles; in
+    /// answerRequests this rank's partial omega on the tiles asked for
+    hugeVector<double> omega_;
+    /// while the lone points are found: per view tile its omega's place in
+    /// omega_ (-1: none), on the tiles where two or more points' w^2 are > 0
     std::vector<std::int32_t> omegaSlot_;
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
+    /// per rank: per tile it sends here and omega value, the nodes where its
+    /// partial omega is > 0 (bit n: node n)
+    std::vector<std::vector<std::uint64_t>> maskFrom_;
     std::vector<std::int64_t> ownToView_;              ///< own tile id -> view id (parallel)
     /// per rank: the tiles this rank asked it for, each key followed by the
     /// nodes this rank reads there (bit n: node n)
@@ -68,20 +70,17 @@ class levelPlanner
     bool viewIsDense() const;
     template <class Slot>
     void ownOmega(const std::vector<stencilTiles<D>>& tiles, std::int64_t nSlots, Slot slot);
+    template <class Slot>
+    void formOmega(std::int64_t nSlots, Slot slot);
     void omegaWhereShared();
     /// omega at view tile id's nodes (not inverted), where aloneAtNodes reads it
-    const double* omegaAt(std::int64_t id) const
-    {
-        const std::int64_t at = omegaSlot_.empty() ? id : omegaSlot_[id];
-        return (omegaSlot_.empty() ? L_.invOmega.data() : ownOmega_.data()) + at*npt*omegaPerNode_;
-    }
+    const double* omegaAt(std::int64_t id) const { return omega_.data() + omegaSlot_[id]*npt*omegaPerNode_; }
     std::vector<std::vector<std::int64_t>> bucketDirectory();
     std::vector<indexBox<D>> clusterTileBoxes(indexBox<D>& all) const;
     std::vector<std::vector<std::uint64_t>> tileRequests(const std::vector<std::vector<std::int64_t>>& directory) const;
     void answerRequests();
     std::vector<std::vector<double>> chooseGhosts();
     void assembleView();
-    void sumOmega(const std::vector<std::int64_t>& ownToView);
     void findControlTiles();
     bool aloneAtNodes(std::size_t q, const stencil<D>& st, bool freeZero) const;
     void testSeparation();
@@ -95,9 +94,7 @@ class levelPlanner
     /// partial omega is > 0: where its partial sums can be other than 0
     std::uint64_t anyValue(const std::vector<std::uint64_t>& masks, std::int64_t id) const
     {
-        std::uint64_t nodes = 0;
-        for (int c = 0; c < omegaPerNode_; ++c) nodes |= masks[id*omegaPerNode_ + c];
-        return nodes;
+        return mba::anyValue(masks, id, omegaPerNode_);
     }
     void findCoefficientNodes();
     void findCoefficientRuns();
