@@ -54,10 +54,12 @@ template <int D>
 std::vector<std::vector<std::int64_t>> levelPlanner<D>::bucketDirectory()
 {
     const tileLayout<D>& own = L_.ownLayout;
+    // (the tiles' coordinates decoded once: the bisection compares them often)
+    std::vector<index<D>> at(nOwn_);
+    for (std::int64_t id = 0; id < nOwn_; ++id) at[id] = own.coord(own.keyOf(id));
     const auto buckets = bisect<D>(nOwn_, [&](std::int64_t id) {
-        const index<D> t = own.coord(own.keyOf(id));
         std::array<double, D> x;
-        for (int d = 0; d < D; ++d) x[d] = double(t[d]);
+        for (int d = 0; d < D; ++d) x[d] = double(at[id][d]);
         return x;
     }, bucketTiles_);
     std::vector<std::int64_t> myBoxes;
@@ -65,10 +67,7 @@ std::vector<std::vector<std::int64_t>> levelPlanner<D>::bucketDirectory()
     {
         indexBox<D> bb = emptyIndexBox<D>();
         for (auto id : g)
-        {
-            const index<D> t = own.coord(own.keyOf(id));
-            for (int d = 0; d < D; ++d) { bb.lo[d] = std::min(bb.lo[d], t[d]); bb.hi[d] = std::max(bb.hi[d], t[d]); }
-        }
+            for (int d = 0; d < D; ++d) { bb.lo[d] = std::min(bb.lo[d], at[id][d]); bb.hi[d] = std::max(bb.hi[d], at[id][d]); }
         myBoxes.insert(myBoxes.end(), bb.lo.begin(), bb.lo.end());
         myBoxes.insert(myBoxes.end(), bb.hi.begin(), bb.hi.end());
     }
