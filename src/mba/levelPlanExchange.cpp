@@ -16,7 +16,11 @@ template <int D>
 void levelPlanner<D>::chooseExchange()
 {
     if (mode_ == params::exchangeMode::direct || L_.separated) return;
-    if (mode_ != params::exchangeMode::tree)
+    // (automatic on two ranks: the chunks never make a rank receive fewer
+    // values; a node it reads that the other rank weighs comes once either
+    // way, and as a node's owner it may receive partial sums it does not read)
+    const bool chunksCanWin = mode_ != params::exchangeMode::automatic || nRanks_ > 2;
+    if (mode_ != params::exchangeMode::tree && chunksCanWin)
     {
         // the nodes this rank reads, per view tile (it asks every holder of a
         // tile for the same nodes)
