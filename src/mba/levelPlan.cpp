@@ -122,7 +122,7 @@ void levelPlanner<D>::findCoefficientRuns()
     auto& runs = L_.coefficientRuns;
     for (std::int64_t n = 0; n < nNodes; ++n)
     {
-        if ((!loneNodes_.empty() && loneNodes_[n]) || !coefficient(n)) continue;
+        if ((!loneNodes_.empty() && (loneNodes_[n/npt] >> (n % npt) & 1)) || !coefficient(n)) continue;
         if (!runs.empty() && runs.back().first + runs.back().second == n) ++runs.back().second;
         else runs.emplace_back(n, 1);
     }

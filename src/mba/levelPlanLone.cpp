@@ -92,7 +92,7 @@ void levelPlanner<D>::storeLoneTilesLast()
         }
     };
     permute(L_.coefficientNodes, std::size_t(omegaPerNode_));
-    permute(loneNodes_, std::size_t(npt));
+    permute(loneNodes_, 1);
     for (stencilTiles<D>& tid : L_.controlTiles)
         for (std::int32_t& id : tid) if (id >= 0) id = std::int32_t(to[id]);
     for (auto* lists : {&L_.tilesTo, &L_.tilesFrom})
@@ -180,20 +180,25 @@ void levelPlanner<D>::findLonePoints()
     std::vector<std::uint8_t> read(nRanks_ > 1 ? L_.view.size() : 0, 0);
     for (const auto& tiles : L_.tilesTo)
         for (const std::int64_t id : tiles) read[id] = 1;
-    std::vector<stencil<D>> st(nq);
-    for (std::size_t q = 0; q < nq; ++q) st[q] = ctrl_.stencilAt(q, L_.scale);
     L_.lone.assign(nq, 0);
     loneNodes_.clear();
-    for (std::size_t q = 0; q < nq; ++q)
+    // (stencils q - 1, q and q + 1 in turn: a point with a neighbour in
+    // order at the same nodes is not alone)
+    stencil<D> before, st, after;
+    if (nq > 0) st = ctrl_.stencilAt(0, L_.scale);
+    for (std::size_t q = 0; q < nq; before = st, st = after, ++q)
     {
-        if ((q > 0 && st[q - 1].base == st[q].base) || (q + 1 < nq && st[q + 1].base == st[q].base)) continue;
+        if (q + 1 < nq) after = ctrl_.stencilAt(q + 1, L_.scale);
+        if ((q > 0 && before.base == st.base) || (q + 1 < nq && after.base == st.base)) continue;
         bool alone = true;
         for (const std::int32_t id : L_.controlTiles[q]) alone = alone && !(id >= 0 && !read.empty() && read[id]);
-        alone = alone && aloneAtNodes(q, st[q], true);
+        alone = alone && aloneAtNodes(q, st, true);
         L_.lone[q] = alone;
         if (!alone) continue;
-        loneNodes_.resize(std::size_t(L_.view.size())*npt, 0);
-        detail::visitStencil(L_.controlTiles[q], st[q], [&](std::int64_t id, int n, double) { loneNodes_[id*npt + n] = 1; });
+        loneNodes_.resize(std::size_t(L_.view.size()), 0);
+        detail::visitStencil(L_.controlTiles[q], st, [&](std::int64_t id, int n, double) {
+            loneNodes_[id] |= std::uint64_t(1) << n;
+        });
     }
     if (loneNodes_.empty()) L_.lone.clear();
 }

@@ -60,8 +60,8 @@ class levelPlanner
     std::vector<std::vector<std::uint64_t>> requests_;
     /// per rank: the nodes it reads of each tile in tilesTo
     std::vector<std::vector<std::uint64_t>> asked_;
-    /// per view node: 1 at the lone points' nodes (empty: no lone point)
-    std::vector<std::uint8_t> loneNodes_;
+    /// per view tile: the lone points' nodes (bit n: node n; empty: no lone point)
+    std::vector<std::uint64_t> loneNodes_;
 
     void startLevel(int k);
     void ownTiles();
