@@ -83,6 +83,51 @@ TEST_CASE("chunked exchange: a rank receives a shared tile's worth, however many
     }
 }
 
+TEST_CASE("chunked exchange: on two ranks no rank receives fewer values than directly", "[parallel][chunks]")
+{
+    // (why `automatic` plans no chunks on two ranks: a node a rank reads
+    // that the other weighs comes once either way, and as a node's owner it
+    // may receive partial sums it does not read)
+    const bool masked = GENERATE(false, true);
+    const bool surface = GENERATE(true, false);
+    const partition how = GENERATE(partition::slabs, partition::boxes, partition::random);
+    const auto c = surface ? surfacePoints<3>(14) : randomPoints<3>(1500, 75);
+    const auto e = randomPoints<3>(1500, 73);
+    problem pb;
+    pb.p.tolerance = 1e-9;
+    pb.p.bucketTiles = 8;
+    const std::vector<double> v = smoothValues<3>(c, pb.nc);
+    const std::vector<std::uint8_t> mask = masked ? mixedMask(c.size(), pb.nc) : std::vector<std::uint8_t>();
+    std::map<params::exchangeMode, std::vector<std::vector<levelStats>>> st;
+    for (const auto mode : {params::exchangeMode::chunked, params::exchangeMode::direct, params::exchangeMode::automatic})
+    {
+        st[mode].resize(2);
+        pb.stats = &st[mode];
+        pb.p.exchange = mode;
+        solve<3>(2, how, c, v, mask, e, pb);
+    }
+    INFO("masked " << masked << ", surface " << surface << ", partition " << name(how));
+    const auto& chunked = st[params::exchangeMode::chunked];
+    const auto& direct = st[params::exchangeMode::direct];
+    int chunkedLevels = 0;
+    std::int64_t more = 0;   // values received beyond the direct exchange's
+    for (int r = 0; r < 2; ++r)
+    {
+        REQUIRE(chunked[r].size() == direct[r].size());
+        for (std::size_t k = 0; k < chunked[r].size(); ++k)
+        {
+            if (!chunked[r][k].chunked) continue;
+            INFO("rank " << r << ", level " << k);
+            chunkedLevels += r == 0;
+            CHECK(chunked[r][k].bytesReceivedPerApply >= direct[r][k].bytesReceivedPerApply);
+            more += chunked[r][k].bytesReceivedPerApply - direct[r][k].bytesReceivedPerApply;
+        }
+        for (const levelStats& s : st[params::exchangeMode::automatic][r]) CHECK(!s.chunked);
+    }
+    CHECK(chunkedLevels >= 4);
+    CHECK(more > 0);
+}
+
 TEST_CASE("tree sum: the same bits on every rank, one message a round", "[parallel][tree]")
 {
     const int P = GENERATE(2, 3, 5, 6, 7, 8, 16);
