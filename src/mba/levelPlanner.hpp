@@ -48,6 +48,7 @@ class levelPlanner
     hugeVector<double> omega_;
     /// while the lone points are found: per view tile its omega's place in
     /// omega_ (-1: none), on the tiles where two or more points' w^2 are > 0
+    /// (on a dense view every tile: its omega is kept)
     std::vector<std::int32_t> omegaSlot_;
     std::vector<std::vector<std::uint64_t>> keysFrom_; ///< per rank: keys of the tiles it sends here
     std::vector<std::vector<double>> omegaFrom_;       ///< per rank: their partial omega
