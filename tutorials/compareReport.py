@@ -58,10 +58,12 @@ def row(method, amplitude, run, status):
                                    "%.6g %.6g" % layers if layers else "")
 
 def label(token):
-    """S, S/on|off, S/on|off/I or S/on|off/I/L: the method's name in the tables"""
-    solver, layers, start, level = (token.split("/") + ["", "", ""])[:4]
+    """S, S/on|off, S/on|off/I or S/on|off/I/L, each with an optional +rebase: the method's name in the
+    tables"""
+    rebase = token.endswith("+rebase")
+    solver, layers, start, level = (token[:len(token) - 7 * rebase].split("/") + ["", "", ""])[:4]
     return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "") \
-        + (" level " + level if level else "")
+        + (" level " + level if level else "") + (", rebase on" if rebase else "")
 
 def readRuns(rowsPath):
     """[(method label, amplitude, measures {name: value} or None, status)]"""

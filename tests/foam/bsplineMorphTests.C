@@ -417,6 +417,8 @@ TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bs
         && Contains("default 30"));
     CHECK(errorOf("curvedSlipAngle 45;") == "no error");
     CHECK_THAT(errorOf("relativeTolerance perhaps;"), Contains("perhaps"));
+    CHECK_THAT(errorOf("rebase perhaps;"), Contains("perhaps") && Contains("on/off"));
+    CHECK(errorOf("rebase on;") == "no error");
     const std::string exchange = errorOf("exchange sideways;");
     CHECK_THAT(exchange, Contains("'exchange' is 'sideways'") && Contains("automatic") && Contains("direct")
         && Contains("chunked") && Contains("tree"));
@@ -466,6 +468,7 @@ TEST_CASE("RBF: invalid keyword values name the entry and the choices", "[foam][
     CHECK_THAT(errorOf("function thinPlateSpline; polynomial false;", "RBF"),
         Contains("thinPlateSpline") && Contains("polynomial"));
     CHECK_THAT(errorOf("invertedCells maybe;", "RBF"), Contains("'invertedCells' is 'maybe'"));
+    CHECK_THAT(errorOf("rebase perhaps;", "RBF"), Contains("perhaps") && Contains("on/off"));
     CHECK_THAT(errorOf("curvedSlipAngle -1;", "RBF"), Contains("'curvedSlipAngle' is -1") && Contains("from 0 to 89"));
     CHECK(errorOf("function wendlandC2; supportRadius 2; polynomial false;", "RBF") == "no error");
 }

@@ -249,12 +249,12 @@ Foam::RBFMotionSolver::newInterpolator
         if (D == 3)
         {
             interpolator.reset(new rbfInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, base(), evalCoordinates(), nEval));
         }
         else
         {
             interpolator.reset(new rbfInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval));
+                (comm_, params_, bc, base(), evalCoordinates(), nEval));
         }
     }
     catch (const std::exception& e)

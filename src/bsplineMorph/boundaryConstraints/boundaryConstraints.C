@@ -104,7 +104,8 @@ Foam::boundaryConstraints::boundaryConstraints
 (
     const pointVectorField& pointDisplacement,
     const pointField& points0,
-    const scalar curvedSlipAngle
+    const scalar curvedSlipAngle,
+    const vectorField* shift
 )
 :
     pMesh_(pointDisplacement.mesh()),
@@ -153,7 +154,7 @@ Foam::boundaryConstraints::boundaryConstraints
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
 
-    update(pointDisplacement);
+    update(pointDisplacement, shift);
 }
 
 

@@ -319,7 +319,11 @@ void Foam::boundaryConstraints::checkPrescribed
 }
 
 
-void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement)
+void Foam::boundaryConstraints::update
+(
+    const pointVectorField& pointDisplacement,
+    const vectorField* shift
+)
 {
     resetPointArrays();
     wordHashSet nonFinite;
@@ -366,6 +370,10 @@ void Foam::boundaryConstraints::update(const pointVectorField& pointDisplacement
     for (const label pointi : boundaryPoints_)
     {
         fixed_[pointi] = fixedSync_[pointi] != 0;
+        if (shift && fixed_[pointi])
+        {
+            value_[pointi] -= (*shift)[pointi];
+        }
     }
     collectControls();
 }

@@ -67,7 +67,8 @@ namespace Foam
 Foam::scalar Foam::interpolatingMotionSolver::checkCells
 (
     const pointField& points,
-    label& nInvalid
+    label& nInvalid,
+    const bool mayRebase
 )
 {
     const clockTime timer;
@@ -77,7 +78,7 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
     }
     const invertedCellCheck::result r = checkPtr_->check(points);
     nInvalid = r.nInvalid;
-    if (r.nInvalid == 0)
+    if (r.nInvalid == 0 || mayRebase)
     {
         return timer.elapsedTime();
     }
@@ -100,9 +101,11 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
     {
         FatalErrorInFunction
             << "The prescribed motion inverts " << what.str().c_str()
+            << (rebase_ ? ", morphed from the last step's mesh too (rebase on)" : "")
             << "; the mesh is not moved."
             << " Smaller motion steps, other " << type() << "Coeffs"
-            << " settings, or invertedCells warn (to continue anyway) are"
+            << " settings, " << (rebase_ ? "" : "rebase on (to morph from the last step's mesh), ")
+            << "or invertedCells warn (to continue anyway) are"
             << " the options" << exit(FatalError);
     }
     WarningInFunction
@@ -139,7 +142,7 @@ void Foam::interpolatingMotionSolver::setEvalPoints()
     }
     evalPoints_.transfer(points);
     const solutionFrame& frame = constraintsPtr_->frame();
-    const pointField& p0 = points0();
+    const pointField& p0 = base();
     reserveOnHugePages(evalXyz_, frame.size()*evalPoints_.size());
     for (const label pointi : evalPoints_)
     {
@@ -172,7 +175,7 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateInto
     // The interpolated points' displacement (zero outside the solution
     // directions) and their moved points, in one pass
     const solutionFrame& frame = constraintsPtr_->frame();
-    const pointField& p0 = points0();
+    const pointField& p0 = base();
     const double* v = values_.data();
     if (frame.axisymmetric())
     {
@@ -223,6 +226,7 @@ void Foam::interpolatingMotionSolver::warnUnknownKeywords
     const dictionary& dict = coeffDict();
     wordList all(known);
     all.append("invertedCells");
+    all.append("rebase");
     all.append("curvedSlipAngle");
     all.append("rigidLayers");
     if (dict.dictName() == coeffsName)
@@ -300,10 +304,12 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    rebase_(coeffDict().lookupOrDefault<bool>("rebase", false)),
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    readBase(type);
 }
 
 
@@ -318,10 +324,12 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
 :
     displacementMotionSolver(mesh, dict, pointDisplacement, points0, type),
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
+    rebase_(coeffDict().lookupOrDefault<bool>("rebase", false)),
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    readBase(type);
 }
 
 
@@ -361,14 +369,17 @@ bool Foam::interpolatingMotionSolver::updateControls()
     {
         constraintsPtr_.reset
         (
-            new boundaryConstraints(pointDisplacement_, points0(), curvedSlipAngle_)
+            new boundaryConstraints
+            (
+                pointDisplacement_, base(), curvedSlipAngle_, shift()
+            )
         );
     }
     else
     {
         points = constraintsPtr_->controlPoints();
         mask = constraintsPtr_->mask();
-        constraintsPtr_->update(pointDisplacement_);
+        constraintsPtr_->update(pointDisplacement_, shift());
     }
     // The rigid layers' outermost points are control points too
     if (rigidLayersPtr_)
@@ -377,7 +388,7 @@ bool Foam::interpolatingMotionSolver::updateControls()
         {
             rigidLayersPtr_->checkConstrained(*constraintsPtr_);
         }
-        rigidLayersPtr_->addControls(*constraintsPtr_, points0());
+        rigidLayersPtr_->addControls(*constraintsPtr_, points0(), shift());
     }
     return first || !constraintsPtr_->sameControls(points, mask);
 }
@@ -433,7 +444,8 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
             bc.fixed(),
             bc.frame(),
             displacement,
-            newPoints_
+            newPoints_,
+            shift()
         );
     }
     return report;
@@ -447,7 +459,7 @@ void Foam::interpolatingMotionSolver::moveBoundaryPoints
 {
     // The points the conditions fix or constrain (the interpolated ones
     // moved already); the cyclic pairs matched exactly
-    const pointField& p0 = points0();
+    const pointField& p0 = base();
     constraintsPtr_->matchCyclic(displacement);
     constraintsPtr_->constrain(displacement);
     for (const label pointi : constraintsPtr_->boundaryPoints())
@@ -482,19 +494,17 @@ void Foam::interpolatingMotionSolver::correctBoundaryValues
 }
 
 
-void Foam::interpolatingMotionSolver::solve()
+Foam::interpolationReport Foam::interpolatingMotionSolver::morph
+(
+    vectorField& displacement,
+    const bool changed
+)
 {
-    const logPrecision digits;
-    const clockTime timer;
-    const bool changed = updateControls();
-    const scalar conditionsSeconds = timer.elapsedTime();
-
     // The displacement is worked out in pointDisplacement's own values (the
     // conditions have been read), and the moved points beside it: every point
     // is set, the interpolated ones by interpolateField (zero outside the
-    // solution directions), the boundary ones by moveBoundaryPoints, which
-    // also zeroes the directions a 2D mesh does not solve for
-    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
+    // solution directions), the boundary ones by moveBoundaryPoints (after
+    // this), which also zeroes the directions a 2D mesh does not solve for
     setSizeOnHugePages(newPoints_, points0().size());
     interpolationReport report;
     if (constraintsPtr_->nControlGlobal() == 0)
@@ -503,19 +513,57 @@ void Foam::interpolatingMotionSolver::solve()
             << "No control points: no patch of pointDisplacement fixes a value"
             << " or slides; the mesh keeps its initial points" << endl;
         displacement = Zero;
-        newPoints_ = points0();
+        newPoints_ = base();
         clearPlan();
     }
     else
     {
         report = interpolateField(displacement, changed);
     }
-    const scalar beforeBoundary = timer.elapsedTime();
+    return report;
+}
+
+
+void Foam::interpolatingMotionSolver::solve()
+{
+    const logPrecision digits;
+    const clockTime timer;
+    if (rebase_)
+    {
+        rebaseIfStrained();
+    }
+    bool changed = updateControls();
+    scalar conditionsSeconds = timer.elapsedTime();
+    vectorField& displacement = pointDisplacement_.primitiveFieldRef();
+    interpolationReport report = morph(displacement, changed);
+    scalar before = timer.elapsedTime();
     moveBoundaryPoints(displacement);
+    scalar boundarySeconds = timer.elapsedTime() - before;
     label nInvalid = 0;
-    const scalar checkSeconds = checkCells(newPoints_, nInvalid);
+    scalar checkSeconds = checkCells(newPoints_, nInvalid, rebase_);
+    if (nInvalid > 0 && rebase_)
+    {
+        // Morphed again from the last step's mesh, or refused
+        if (rebase("the morph from " + baseName() + " would invert " + Foam::name(nInvalid) + " cells"))
+        {
+            before = timer.elapsedTime();
+            changed = updateControls();
+            conditionsSeconds += timer.elapsedTime() - before;
+            report = morph(displacement, changed);
+            before = timer.elapsedTime();
+            moveBoundaryPoints(displacement);
+            boundarySeconds += timer.elapsedTime() - before;
+        }
+        checkSeconds += checkCells(newPoints_, nInvalid, false);
+    }
+    before = timer.elapsedTime();
+    // (the displacement from points0: pointDisplacement's meaning)
+    if (shift())
+    {
+        displacement += shift_;
+    }
     correctBoundaryValues(displacement);
-    const scalar boundarySeconds = timer.elapsedTime() - beforeBoundary - checkSeconds;
+    boundarySeconds += timer.elapsedTime() - before;
 
     if (!report.summary.empty())
     {
@@ -583,7 +631,10 @@ void Foam::interpolatingMotionSolver::movePoints(const pointField& p)
 void Foam::interpolatingMotionSolver::updateMesh(const mapPolyMesh& mpm)
 {
     displacementMotionSolver::updateMesh(mpm);
-    // points0 changed: the plans are rebuilt at the next solve
+    // points0 changed: the plans are rebuilt at the next solve, from it
+    basePtr_.clear();
+    shift_.clear();
+    baseVolumes_.clear();
     if (rigidLayersPtr_)
     {
         rigidLayersPtr_->clearPlan();

@@ -424,13 +424,13 @@ Foam::multilevelBSplineMotionSolver::newInterpolator
         if (D == 3)
         {
             interpolator.reset(new bsplineInterpolator<3>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
+                (comm_, params_, bc, base(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
                  warnedNotReached_));
         }
         else if (D == 2)
         {
             interpolator.reset(new bsplineInterpolator<2>
-                (comm_, params_, bc, points0(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
+                (comm_, params_, bc, base(), evalCoordinates(), nEval, std::move(read), trendGrid_, trendLevel_,
                  warnedNotReached_));
         }
         else

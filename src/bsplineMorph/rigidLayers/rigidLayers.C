@@ -509,7 +509,8 @@ Foam::vector Foam::rigidLayers::rigidMotion
 void Foam::rigidLayers::addControls
 (
     boundaryConstraints& bc,
-    const pointField& points0
+    const pointField& points0,
+    const vectorField* shift
 )
 {
     if (!planned_)
@@ -521,7 +522,12 @@ void Foam::rigidLayers::addControls
     // The feet's rigid motions from the prescribed wall displacements alone
     // (the sliding ones are known only after the fit)
     const boolList& fixed = bc.fixed();
-    const vectorField& prescribed = bc.prescribed();
+    // (from points0: a rebased morph's values are taken from its base)
+    const tmp<vectorField> tprescribed
+    (
+        shift ? tmp<vectorField>(bc.prescribed() + *shift) : tmp<vectorField>(bc.prescribed())
+    );
+    const vectorField& prescribed = tprescribed();
     fitRotations(points0, prescribed, &fixed);
     // Walls all of whose points are prescribed (in 3D: in 2D the part of a
     // prescribed value across the frame is dropped later) have these transforms
@@ -553,7 +559,7 @@ void Foam::rigidLayers::addControls
         const label j = zoneFoot_[i];
         if (footFixed[j])
         {
-            bc.fix(pointi, rigidMotion(j, zoneArm_[i]));
+            bc.fix(pointi, rigidMotion(j, zoneArm_[i]) - (shift ? (*shift)[pointi] : Zero));
         }
         else if (footSlide[j].first() > 0)
         {
@@ -572,7 +578,7 @@ void Foam::rigidLayers::addControls
         const label j = zoneFoot_[i];
         if (!fixed[pointi] && slides[pointi].first() > 0 && footFixed[j])
         {
-            vector r = rigidMotion(j, zoneArm_[i]);
+            vector r = rigidMotion(j, zoneArm_[i]) - (shift ? (*shift)[pointi] : Zero);
             r = slides[pointi].constrainDisplacement(r);
             bc.fix(pointi, r);
         }
@@ -587,12 +593,18 @@ void Foam::rigidLayers::apply
     const boolList& fixed,
     const solutionFrame& frame,
     vectorField& displacement,
-    pointField& newPoints
+    pointField& newPoints,
+    const vectorField* shift
 )
 {
     if (!planned_)
     {
         plan(points0);
+    }
+    // (the displacement from points0: a rebased morph's is from its base)
+    if (shift)
+    {
+        displacement += *shift;
     }
     if (!transformsFinal_)
     {
@@ -620,6 +632,10 @@ void Foam::rigidLayers::apply
         }
         d = frame.inFrame(pointi, rigid);
         newPoints[pointi] = points0[pointi] + d;
+    }
+    if (shift)
+    {
+        displacement -= *shift;
     }
 }
 

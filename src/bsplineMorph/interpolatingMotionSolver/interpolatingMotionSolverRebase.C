@@ -1,0 +1,251 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+Description
+    rebase on: the morph starts from the last step's mesh instead of points0
+    once a cell's volume has halved or doubled since the mesh it starts from,
+    or where it would invert cells. A smooth field that closes a gap strains
+    its middle more than its ends (the walls hold it flat there); morphed in
+    stages from the last mesh, each stage's strain acts on the cells as the
+    last one left them, so that the squeezed cells are squeezed in proportion
+    (their lengths multiply) instead of by the same amount (which takes the
+    most squeezed to zero first). The base is written at the write times as
+    <time>/polyMesh/morphBase (binary) and read back on a restart.
+
+\*---------------------------------------------------------------------------*/
+
+#include "interpolatingMotionSolver.H"
+
+// * * * * * * * * * * * * * * * Local Constants * * * * * * * * * * * * * * //
+
+namespace Foam
+{
+namespace
+{
+    //- A cell's volume over its volume in the base (or the inverse) below
+    //  which the morph is rebased
+    constexpr scalar rebaseVolumeRatio = 0.5;
+
+    const word morphBaseName("morphBase");
+
+    //- The base as written: binary whatever the case's writeFormat, so that
+    //  a restart morphs from the same bits
+    class morphBase
+    :
+        public pointIOField
+    {
+    public:
+
+        using pointIOField::pointIOField;
+
+        virtual bool writeObject
+        (
+            IOstream::streamFormat,
+            IOstream::versionNumber ver,
+            IOstream::compressionType,
+            const bool valid
+        ) const
+        {
+            return pointIOField::writeObject
+            (
+                IOstream::BINARY, ver, IOstream::UNCOMPRESSED, valid
+            );
+        }
+    };
+}
+}
+
+
+// * * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+void Foam::interpolatingMotionSolver::readBase(const word& type)
+{
+    if (!rebase_)
+    {
+        return;
+    }
+    const Time& runTime = mesh().time();
+    IOobject io
+    (
+        morphBaseName,
+        runTime.findInstance
+        (
+            polyMesh::meshSubDir, morphBaseName, IOobject::READ_IF_PRESENT
+        ),
+        polyMesh::meshSubDir,
+        mesh(),
+        IOobject::MUST_READ,
+        IOobject::AUTO_WRITE
+    );
+    if (!returnReduce(io.typeHeaderOk<pointIOField>(false), orOp<bool>()))
+    {
+        return;
+    }
+    basePtr_.reset(new morphBase(io));
+    if (basePtr_().size() != points0().size())
+    {
+        FatalErrorInFunction
+            << "The morph's base has " << basePtr_().size() << " points, the"
+            << " mesh " << points0().size() << ": remove " << io.objectPath()
+            << " (the morph then starts from the initial mesh)"
+            << exit(FatalError);
+    }
+    shift_ = basePtr_() - points0();
+    Info<< type << ": rebased, morphing from the mesh in "
+        << runTime.relativePath(io.objectPath()).c_str() << endl;
+}
+
+
+Foam::tmp<Foam::scalarField> Foam::interpolatingMotionSolver::cellVolumesOf
+(
+    const pointField& points
+) const
+{
+    const faceList& faces = mesh().faces();
+    const labelList& owner = mesh().faceOwner();
+    const labelList& neighbour = mesh().faceNeighbour();
+    const cellList& cells = mesh().cells();
+    tmp<scalarField> tV(new scalarField(mesh().nCells(), Zero));
+    scalarField& V = tV.ref();
+    // Against a point of the cell (its first face's first), the divergence
+    // theorem: exact for planar faces
+    auto refOf = [&](const label celli) -> const point&
+    {
+        return points[faces[cells[celli][0]][0]];
+    };
+    forAll(faces, facei)
+    {
+        const face& f = faces[facei];
+        point m = Zero;
+        for (const label pointi : f)
+        {
+            m += points[pointi];
+        }
+        m /= f.size();
+        vector S = Zero;
+        forAll(f, i)
+        {
+            S += (points[f[i]] - m) ^ (points[f.nextLabel(i)] - m);
+        }
+        V[owner[facei]] += S & (m - refOf(owner[facei]));
+        if (facei < neighbour.size())
+        {
+            V[neighbour[facei]] -= S & (m - refOf(neighbour[facei]));
+        }
+    }
+    V /= 6;
+    return tV;
+}
+
+
+Foam::string Foam::interpolatingMotionSolver::baseName() const
+{
+    return basePtr_.valid() ? "the mesh the morph was rebased on" : "the initial mesh";
+}
+
+
+bool Foam::interpolatingMotionSolver::rebaseIfStrained()
+{
+    // The mesh's volumes (OpenFOAM's: the flow solver has them), against
+    // the base's: those of the mesh when it was taken, else (the first step)
+    // the mesh's own where the base is the mesh (a run from its initial
+    // points), computed where it is not (a restart)
+    const scalarField& V = mesh().cellVolumes();
+    if (baseVolumes_.size() != V.size())
+    {
+        const pointField& p = mesh().points();
+        const pointField& b = base();
+        bool same = true;
+        forAll(p, pointi)
+        {
+            same = same && p[pointi] == b[pointi];
+        }
+        baseVolumes_ = returnReduce(same, andOp<bool>()) ? V : cellVolumesOf(b)();
+    }
+    scalar least = 1;
+    forAll(V, celli)
+    {
+        const scalar r = V[celli]/baseVolumes_[celli];
+        least = min(least, r > 0 ? min(r, 1/r) : 0);
+    }
+    reduce(least, minOp<scalar>());
+    if (least >= rebaseVolumeRatio)
+    {
+        return false;
+    }
+    return rebase
+    (
+        "a cell's volume changed by a factor "
+      + Foam::name(1/max(least, VSMALL)) + " since " + baseName()
+    );
+}
+
+
+bool Foam::interpolatingMotionSolver::rebase(const string& why)
+{
+    // (nothing to gain where the mesh is the base already: the first step,
+    // or a step morphed again)
+    const pointField& p = mesh().points();
+    const pointField& b = base();
+    scalar moved = 0;
+    forAll(p, pointi)
+    {
+        moved = max(moved, magSqr(p[pointi] - b[pointi]));
+    }
+    if (returnReduce(moved, maxOp<scalar>()) == 0)
+    {
+        return false;
+    }
+    const Time& runTime = mesh().time();
+    Info<< type() << ": " << why.c_str() << " (rebase on), at time "
+        << runTime.timeName()
+        << ": rebased on the last step's mesh (planned again)" << endl;
+    if (basePtr_.valid())
+    {
+        basePtr_() = p;
+    }
+    else
+    {
+        basePtr_.reset
+        (
+            new morphBase
+            (
+                IOobject
+                (
+                    morphBaseName,
+                    runTime.timeName(),
+                    polyMesh::meshSubDir,
+                    mesh(),
+                    IOobject::NO_READ,
+                    IOobject::AUTO_WRITE
+                ),
+                p
+            )
+        );
+    }
+    shift_ = basePtr_() - points0();
+    baseVolumes_ = mesh().cellVolumes();
+    // The plans are made again from the new base (the rigid layers' stays:
+    // its zone, feet and weights are those of points0)
+    constraintsPtr_.reset();
+    refitPtr_.reset();
+    evalPoints_.clear();
+    evalXyz_.clear();
+    clearPlan();
+    return true;
+}
+
+
+// ************************************************************************* //
