@@ -100,8 +100,9 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
     if (invertedCellsFatal_)
     {
         FatalErrorInFunction
-            << "The prescribed motion inverts " << what.str().c_str()
-            << (rebase_ ? ", morphed from the last step's mesh too (rebase on)" : "")
+            << "The prescribed motion"
+            << (rebase_ ? ", morphed from the last step's mesh (rebase on)," : "")
+            << " inverts " << what.str().c_str()
             << "; the mesh is not moved."
             << " Smaller motion steps, other " << type() << "Coeffs"
             << " settings, " << (rebase_ ? "" : "rebase on (to morph from the last step's mesh), ")

@@ -522,7 +522,8 @@ void Foam::rigidLayers::addControls
     // The feet's rigid motions from the prescribed wall displacements alone
     // (the sliding ones are known only after the fit)
     const boolList& fixed = bc.fixed();
-    // (from points0: a rebased morph's values are taken from its base)
+    // (the walls' displacement from points0: a rebased morph's values are
+    // from its base)
     const tmp<vectorField> tprescribed
     (
         shift ? tmp<vectorField>(bc.prescribed() + *shift) : tmp<vectorField>(bc.prescribed())
