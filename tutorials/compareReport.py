@@ -61,7 +61,7 @@ def label(token):
     """S, S/on|off, S/on|off/I or S/on|off/I/L, each with an optional +rebase: the method's name in the
     tables"""
     rebase = token.endswith("+rebase")
-    solver, layers, start, level = (token[:len(token) - 7 * rebase].split("/") + ["", "", ""])[:4]
+    solver, layers, start, level = (token.removesuffix("+rebase").split("/") + ["", "", ""])[:4]
     return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "") \
         + (" level " + level if level else "") + (", rebase on" if rebase else "")
 

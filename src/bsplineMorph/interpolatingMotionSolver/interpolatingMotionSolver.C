@@ -67,8 +67,7 @@ namespace Foam
 Foam::scalar Foam::interpolatingMotionSolver::checkCells
 (
     const pointField& points,
-    label& nInvalid,
-    const bool mayRebase
+    invertedCellCheck::result& r
 )
 {
     const clockTime timer;
@@ -76,12 +75,16 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
     {
         checkPtr_.reset(new invertedCellCheck(mesh()));
     }
-    const invertedCellCheck::result r = checkPtr_->check(points);
-    nInvalid = r.nInvalid;
-    if (r.nInvalid == 0 || mayRebase)
-    {
-        return timer.elapsedTime();
-    }
+    r = checkPtr_->check(points);
+    return timer.elapsedTime();
+}
+
+
+void Foam::interpolatingMotionSolver::refuseInverted
+(
+    const invertedCellCheck::result& r
+) const
+{
     OStringStream what;
     what<< r.nInvalid << " cells at time " << mesh().time().timeName()
         << " (" << r.nNonPositive << " of non-positive volume, "
@@ -112,7 +115,6 @@ Foam::scalar Foam::interpolatingMotionSolver::checkCells
     WarningInFunction
         << "The morphed mesh has " << r.nInvalid << " inverted cells: "
         << what.str().c_str() << endl;
-    return timer.elapsedTime();
 }
 
 
@@ -540,23 +542,33 @@ void Foam::interpolatingMotionSolver::solve()
     scalar before = timer.elapsedTime();
     moveBoundaryPoints(displacement);
     scalar boundarySeconds = timer.elapsedTime() - before;
-    label nInvalid = 0;
-    scalar checkSeconds = checkCells(newPoints_, nInvalid, rebase_);
-    if (nInvalid > 0 && rebase_)
+    invertedCellCheck::result inverted;
+    scalar checkSeconds = checkCells(newPoints_, inverted);
+    // (rebase on: morphed again from the last step's mesh first)
+    if
+    (
+        inverted.nInvalid > 0 && rebase_
+     && rebase
+        (
+            "the morph from " + baseName() + " would invert "
+          + Foam::name(inverted.nInvalid) + " cells"
+        )
+    )
     {
-        // Morphed again from the last step's mesh, or refused
-        if (rebase("the morph from " + baseName() + " would invert " + Foam::name(nInvalid) + " cells"))
-        {
-            before = timer.elapsedTime();
-            changed = updateControls();
-            conditionsSeconds += timer.elapsedTime() - before;
-            report = morph(displacement, changed);
-            before = timer.elapsedTime();
-            moveBoundaryPoints(displacement);
-            boundarySeconds += timer.elapsedTime() - before;
-        }
-        checkSeconds += checkCells(newPoints_, nInvalid, false);
+        before = timer.elapsedTime();
+        changed = updateControls();
+        conditionsSeconds += timer.elapsedTime() - before;
+        report = morph(displacement, changed);
+        before = timer.elapsedTime();
+        moveBoundaryPoints(displacement);
+        boundarySeconds += timer.elapsedTime() - before;
+        checkSeconds += checkCells(newPoints_, inverted);
     }
+    if (inverted.nInvalid > 0)
+    {
+        refuseInverted(inverted);
+    }
+    const label nInvalid = inverted.nInvalid;
     before = timer.elapsedTime();
     // (the displacement from points0: pointDisplacement's meaning)
     if (shift())

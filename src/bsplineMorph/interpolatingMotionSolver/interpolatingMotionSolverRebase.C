@@ -113,39 +113,13 @@ Foam::tmp<Foam::scalarField> Foam::interpolatingMotionSolver::cellVolumesOf
     const pointField& points
 ) const
 {
-    const faceList& faces = mesh().faces();
-    const labelList& owner = mesh().faceOwner();
-    const labelList& neighbour = mesh().faceNeighbour();
-    const cellList& cells = mesh().cells();
-    tmp<scalarField> tV(new scalarField(mesh().nCells(), Zero));
+    tmp<scalarField> tV(new scalarField(mesh().nCells()));
     scalarField& V = tV.ref();
-    // Against a point of the cell (its first face's first), the divergence
-    // theorem: exact for planar faces
-    auto refOf = [&](const label celli) -> const point&
+    point centre;
+    forAll(V, celli)
     {
-        return points[faces[cells[celli][0]][0]];
-    };
-    forAll(faces, facei)
-    {
-        const face& f = faces[facei];
-        point m = Zero;
-        for (const label pointi : f)
-        {
-            m += points[pointi];
-        }
-        m /= f.size();
-        vector S = Zero;
-        forAll(f, i)
-        {
-            S += (points[f[i]] - m) ^ (points[f.nextLabel(i)] - m);
-        }
-        V[owner[facei]] += S & (m - refOf(owner[facei]));
-        if (facei < neighbour.size())
-        {
-            V[neighbour[facei]] -= S & (m - refOf(neighbour[facei]));
-        }
+        V[celli] = invertedCellCheck::checkMeshVolume(mesh(), points, celli, centre);
     }
-    V /= 6;
     return tV;
 }
 
@@ -159,20 +133,12 @@ Foam::string Foam::interpolatingMotionSolver::baseName() const
 bool Foam::interpolatingMotionSolver::rebaseIfStrained()
 {
     // The mesh's volumes (OpenFOAM's: the flow solver has them), against
-    // the base's: those of the mesh when it was taken, else (the first step)
-    // the mesh's own where the base is the mesh (a run from its initial
-    // points), computed where it is not (a restart)
+    // the base's: those of the mesh when it was taken, else (the first
+    // step) formed from the base's points as OpenFOAM forms them
     const scalarField& V = mesh().cellVolumes();
     if (baseVolumes_.size() != V.size())
     {
-        const pointField& p = mesh().points();
-        const pointField& b = base();
-        bool same = true;
-        forAll(p, pointi)
-        {
-            same = same && p[pointi] == b[pointi];
-        }
-        baseVolumes_ = returnReduce(same, andOp<bool>()) ? V : cellVolumesOf(b)();
+        baseVolumes_ = cellVolumesOf(base());
     }
     scalar least = 1;
     forAll(V, celli)

@@ -558,7 +558,7 @@ Foam::invertedCellCheck::check(const pointField& points) const
 }
 
 
-Foam::label Foam::invertedCellCheck::checkMeshVerdict
+Foam::scalar Foam::invertedCellCheck::checkMeshVolume
 (
     const polyMesh& mesh,
     const pointField& points,
@@ -568,8 +568,7 @@ Foam::label Foam::invertedCellCheck::checkMeshVerdict
 {
     // primitiveMesh::makeCellCentresAndVols for one cell (its faces in
     // cells() order: the owned ones, then the others, each ascending, the
-    // order in which OpenFOAM's loops over owners and neighbours add them),
-    // then checkCellVolumes and checkFacePyramids
+    // order in which OpenFOAM's loops over owners and neighbours add them)
     const labelList& cellFaces = mesh.cells()[celli];
     const labelList& own = mesh.faceOwner();
     const faceList& faces = mesh.faces();
@@ -596,12 +595,26 @@ Foam::label Foam::invertedCellCheck::checkMeshVerdict
         vol += pyr3Vol;
     }
     centre = mag(vol) > VSMALL ? ctr/vol : cEst;
-    vol *= (1.0/3.0);
-    if (vol < VSMALL)
+    return vol*(1.0/3.0);
+}
+
+
+Foam::label Foam::invertedCellCheck::checkMeshVerdict
+(
+    const polyMesh& mesh,
+    const pointField& points,
+    const label celli,
+    point& centre
+)
+{
+    // checkMeshVolume, then checkCellVolumes and checkFacePyramids
+    if (checkMeshVolume(mesh, points, celli, centre) < VSMALL)
     {
         return 1;
     }
-    for (const label facei : cellFaces)
+    const labelList& own = mesh.faceOwner();
+    const faceList& faces = mesh.faces();
+    for (const label facei : mesh.cells()[celli])
     {
         // pyramidPointFaceRef(face, centre).mag(points), negated for the
         // owner: an error below -SMALL, as checkMesh's pyramids, or below

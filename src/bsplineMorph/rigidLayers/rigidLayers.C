@@ -603,14 +603,15 @@ void Foam::rigidLayers::apply
         plan(points0);
     }
     // (the displacement from points0: a rebased morph's is from its base)
-    if (shift)
-    {
-        displacement += *shift;
-    }
+    const tmp<vectorField> tfrom0
+    (
+        shift ? tmp<vectorField>(displacement + *shift) : tmp<vectorField>(displacement)
+    );
+    const vectorField& from0 = tfrom0();
     if (!transformsFinal_)
     {
-        fitRotations(points0, displacement);
-        footDisplacement_ = vectorField(displacement, wallPoints_);
+        fitRotations(points0, from0);
+        footDisplacement_ = vectorField(from0, wallPoints_);
         mapPtr_->distribute(rotation_);
         mapPtr_->distribute(footDisplacement_);
     }
@@ -625,18 +626,15 @@ void Foam::rigidLayers::apply
         const label j = zoneFoot_[i];
         const vector& arm = zoneArm_[i];
         const scalar w = zoneWeight_[i];
-        vector& d = displacement[pointi];
+        const vector& d = from0[pointi];
         vector rigid = rigidMotion(j, arm);
         if (w < 1)
         {
             rigid = d + w*(rigid - d);
         }
-        d = frame.inFrame(pointi, rigid);
-        newPoints[pointi] = points0[pointi] + d;
-    }
-    if (shift)
-    {
-        displacement -= *shift;
+        rigid = frame.inFrame(pointi, rigid);
+        newPoints[pointi] = points0[pointi] + rigid;
+        displacement[pointi] = shift ? rigid - (*shift)[pointi] : rigid;
     }
 }
 
