@@ -58,10 +58,11 @@ def row(method, amplitude, run, status):
                                    "%.6g %.6g" % layers if layers else "")
 
 def label(token):
-    """S, S/on|off, S/on|off/I or S/on|off/I/L, each with an optional +rebase: the method's name in the
-    tables"""
+    """S, S/on|off|sphere, S/on|off/I or S/on|off/I/L, each with an optional +rebase: the method's name
+    in the tables (S/sphere: "rigidLayers on sphere only")"""
     rebase = token.endswith("+rebase")
     solver, layers, start, level = (token.removesuffix("+rebase").split("/") + ["", "", ""])[:4]
+    layers = "on " + layers + " only" if layers not in ("", "on", "off") else layers
     return solver + (", rigidLayers " + layers if layers else "") + (", " + start if start else "") \
         + (" level " + level if level else "") + (", rebase on" if rebase else "")
 

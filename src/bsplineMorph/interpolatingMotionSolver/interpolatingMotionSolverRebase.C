@@ -21,12 +21,15 @@ Description
     stages from the last mesh, each stage's strain acts on the cells as the
     last one left them, so that the squeezed cells are squeezed in proportion
     (their lengths multiply) instead of by the same amount (which takes the
-    most squeezed to zero first). The base is written at the write times as
-    <time>/polyMesh/morphBase (binary) and read back on a restart.
+    most squeezed to zero first). The base is a point field, written at the
+    write times as <time>/morphBase (binary) and read back on a restart, so
+    that decomposePar and reconstructPar carry it as they carry the other
+    point fields.
 
 \*---------------------------------------------------------------------------*/
 
 #include "interpolatingMotionSolver.H"
+#include "calculatedPointPatchFields.H"
 
 // * * * * * * * * * * * * * * * Local Constants * * * * * * * * * * * * * * //
 
@@ -44,11 +47,11 @@ namespace
     //  a restart morphs from the same bits
     class morphBase
     :
-        public pointIOField
+        public pointVectorField
     {
     public:
 
-        using pointIOField::pointIOField;
+        using pointVectorField::pointVectorField;
 
         virtual bool writeObject
         (
@@ -58,7 +61,7 @@ namespace
             const bool valid
         ) const
         {
-            return pointIOField::writeObject
+            return pointVectorField::writeObject
             (
                 IOstream::BINARY, ver, IOstream::UNCOMPRESSED, valid
             );
@@ -80,29 +83,17 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     IOobject io
     (
         morphBaseName,
-        runTime.findInstance
-        (
-            polyMesh::meshSubDir, morphBaseName, IOobject::READ_IF_PRESENT
-        ),
-        polyMesh::meshSubDir,
+        runTime.timeName(),
         mesh(),
         IOobject::MUST_READ,
         IOobject::AUTO_WRITE
     );
-    if (!returnReduce(io.typeHeaderOk<pointIOField>(false), orOp<bool>()))
+    if (!returnReduce(io.typeHeaderOk<pointVectorField>(true), orOp<bool>()))
     {
         return;
     }
-    basePtr_.reset(new morphBase(io));
-    if (basePtr_().size() != points0().size())
-    {
-        FatalErrorInFunction
-            << "The morph's base has " << basePtr_().size() << " points, the"
-            << " mesh " << points0().size() << ": remove " << io.objectPath()
-            << " (the morph then starts from the initial mesh)"
-            << exit(FatalError);
-    }
-    shift_ = basePtr_() - points0();
+    basePtr_.reset(new morphBase(io, pointMesh::New(mesh())));
+    shift_ = base() - points0();
     Info<< type << ": rebased, morphing from the mesh in "
         << runTime.relativePath(io.objectPath()).c_str() << endl;
 }
@@ -178,11 +169,7 @@ bool Foam::interpolatingMotionSolver::rebase(const string& why)
     Info<< type() << ": " << why.c_str() << " (rebase on), at time "
         << runTime.timeName()
         << ": rebased on the last step's mesh (planned again)" << endl;
-    if (basePtr_.valid())
-    {
-        basePtr_() = p;
-    }
-    else
+    if (!basePtr_.valid())
     {
         basePtr_.reset
         (
@@ -192,16 +179,18 @@ bool Foam::interpolatingMotionSolver::rebase(const string& why)
                 (
                     morphBaseName,
                     runTime.timeName(),
-                    polyMesh::meshSubDir,
                     mesh(),
                     IOobject::NO_READ,
                     IOobject::AUTO_WRITE
                 ),
-                p
+                pointMesh::New(mesh()),
+                dimensionedVector(dimLength, Zero),
+                calculatedPointPatchVectorField::typeName
             )
         );
     }
-    shift_ = basePtr_() - points0();
+    basePtr_().primitiveFieldRef() = p;
+    shift_ = base() - points0();
     baseVolumes_ = mesh().cellVolumes();
     // The plans are made again from the new base (the rigid layers' stays:
     // its zone, feet and weights are those of points0)
