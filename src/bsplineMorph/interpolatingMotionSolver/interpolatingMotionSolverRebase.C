@@ -88,9 +88,21 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
         IOobject::MUST_READ,
         IOobject::AUTO_WRITE
     );
-    if (!returnReduce(io.typeHeaderOk<pointVectorField>(true), orOp<bool>()))
+    const bool found = io.typeHeaderOk<pointVectorField>(true);
+    if (!returnReduce(found, orOp<bool>()))
     {
         return;
+    }
+    if (!returnReduce(found, andOp<bool>()))
+    {
+        FatalErrorInFunction
+            << "rebase on: the morph's base " << morphBaseName << " is in "
+            << runTime.timeName() << " of some ranks' directories only ("
+            << (found ? "found" : "not found") << " in "
+            << runTime.relativePath(io.objectPath()).c_str() << "): decompose"
+            << " the case's time " << runTime.timeName() << " again, or remove"
+            << " " << morphBaseName << " from every rank's " << runTime.timeName()
+            << " to morph from the initial mesh" << exit(FatalError);
     }
     basePtr_.reset(new morphBase(io, pointMesh::New(mesh())));
     shift_ = base() - points0();
