@@ -535,34 +535,35 @@ void Foam::interpolatingMotionSolver::solve()
     {
         rebaseIfStrained();
     }
-    bool changed = updateControls();
-    scalar conditionsSeconds = timer.elapsedTime();
     vectorField& displacement = pointDisplacement_.primitiveFieldRef();
-    interpolationReport report = morph(displacement, changed);
-    scalar before = timer.elapsedTime();
-    moveBoundaryPoints(displacement);
-    scalar boundarySeconds = timer.elapsedTime() - before;
+    interpolationReport report;
     invertedCellCheck::result inverted;
-    scalar checkSeconds = checkCells(newPoints_, inverted);
-    // (rebase on: morphed again from the last step's mesh first)
-    if
-    (
-        inverted.nInvalid > 0 && rebase_
-     && rebase
-        (
-            "the morph from " + baseName() + " would invert "
-          + Foam::name(inverted.nInvalid) + " cells"
-        )
-    )
+    scalar conditionsSeconds = 0, boundarySeconds = 0, checkSeconds = 0;
+    scalar before = 0;
+    // The morph, and (rebase on) once more from the last step's mesh where
+    // it would invert cells
+    for (bool retry = rebase_; ; retry = false)
     {
-        before = timer.elapsedTime();
-        changed = updateControls();
+        const bool changed = updateControls();
         conditionsSeconds += timer.elapsedTime() - before;
         report = morph(displacement, changed);
         before = timer.elapsedTime();
         moveBoundaryPoints(displacement);
         boundarySeconds += timer.elapsedTime() - before;
         checkSeconds += checkCells(newPoints_, inverted);
+        if
+        (
+            !retry || inverted.nInvalid == 0
+         || !rebase
+            (
+                "the morph from " + baseName() + " would invert "
+              + Foam::name(inverted.nInvalid) + " cells"
+            )
+        )
+        {
+            break;
+        }
+        before = timer.elapsedTime();
     }
     if (inverted.nInvalid > 0)
     {

@@ -133,7 +133,7 @@ Foam::string Foam::interpolatingMotionSolver::baseName() const
 }
 
 
-bool Foam::interpolatingMotionSolver::rebaseIfStrained()
+void Foam::interpolatingMotionSolver::rebaseIfStrained()
 {
     // The mesh's volumes (OpenFOAM's: the flow solver has them), against
     // the base's: those of the mesh when it was taken, else (the first
@@ -150,15 +150,14 @@ bool Foam::interpolatingMotionSolver::rebaseIfStrained()
         least = min(least, r > 0 ? min(r, 1/r) : 0);
     }
     reduce(least, minOp<scalar>());
-    if (least >= rebaseVolumeRatio)
+    if (least < rebaseVolumeRatio)
     {
-        return false;
+        rebase
+        (
+            "a cell's volume changed by a factor "
+          + Foam::name(1/max(least, VSMALL)) + " since " + baseName()
+        );
     }
-    return rebase
-    (
-        "a cell's volume changed by a factor "
-      + Foam::name(1/max(least, VSMALL)) + " since " + baseName()
-    );
 }
 
 
