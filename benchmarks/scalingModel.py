@@ -60,7 +60,8 @@ its messages (also per neighbour and level), its work and the imbalance.
 choice the rounds, what the busiest rank receives, the model's cost of the
 levels' exchange per step (R alpha + M o + B / beta) on both networks, and
 beside it that of the step's all-gathers and reductions, which every choice
-has.
+has; where the records hold mbaScaling --levels's lines, a second table sets
+beside direct and automatic the cheapest choice per level on each network.
 """
 import math
 import sys
@@ -84,20 +85,31 @@ NETWORKS = {
 
 
 def result_lines(paths):
-    """The RESULT lines of mbaScaling's output files, each as a dict (numbers as floats)"""
+    """The RESULT lines of mbaScaling's output files, each as a dict (numbers
+    as floats); with mbaScaling --levels, "level_lines" holds the per-level lines
+    that follow it (the rank receiving most: level, its exchange, messages
+    and bytes received)"""
     for path in paths:
+        rec = None
         with open(path) as f:
             for line in f:
+                w = line.split()
+                if rec is not None and len(w) >= 6 and w[0].isdigit() and w[1] in ("direct", "chunked", "tree"):
+                    rec["level_lines"].append((int(w[0]), w[1], int(w[4]), int(w[5])))
+                    continue
                 if not line.startswith("RESULT "):
                     continue
-                rec = {}
-                for kv in line.split()[1:]:
+                if rec is not None:
+                    yield rec
+                rec = {"level_lines": []}
+                for kv in w[1:]:
                     k, v = kv.split("=", 1)
                     try:
                         rec[k] = float(v)
                     except ValueError:
                         rec[k] = v
-                yield rec
+        if rec is not None:
+            yield rec
 
 
 def read_records(paths):
@@ -218,6 +230,52 @@ def exchanges_table(paths):
             key[0]**3/1e6, NAMES.get(r["decomposition"], r["decomposition"]), P, r["exchange"], r["exchanges"],
             r["messages_max"], r["recv_bytes_max"], r["recv_bytes_max"]/r["share_bytes"],
             exch("infiniband"), exch("ethernet25"), coll("infiniband")))
+    cheapest_per_level(rows)
+
+
+def level_cost(exchange, P, messages, nbytes, net):
+    """Modelled seconds of one level's exchange: its rounds (one direct, two
+    chunked, the tree's 2 ceil(log2 P), two more where P is not a power of
+    two; none where nothing is received), messages and bytes"""
+    if messages == 0:
+        return 0.0
+    rounds = {"direct": 1, "chunked": 2,
+              "tree": 2*math.ceil(math.log2(P)) + (2 if P & (P - 1) else 0)}[exchange]
+    return rounds*net["alpha"] + messages*net["o"] + nbytes/net["beta"]
+
+
+def cheapest_per_level(rows):
+    """Markdown, from mbaScaling --levels's lines (the rank receiving most
+    in each choice's run): per case and network, the cost of the levels'
+    exchange with direct and with automatic, and with the cheapest of direct,
+    chunked and tree taken per level, and that mix (d, c, t a level; - where
+    the rank receives nothing)"""
+    cases = defaultdict(dict)
+    for (n, o, P, x), r in rows.items():
+        cases[(n, o, P)][EXCHANGES[x]] = r
+    usable = {k: v for k, v in cases.items()
+              if all(x in v and v[x]["level_lines"] for x in EXCHANGES)}
+    if not usable:
+        return
+    print("\nThe cheapest choice per level (each choice's run's rank receiving most, per level its messages and bytes; "
+          "mbaScaling --levels):\n")
+    print("| cells | decomposition | ranks | network | direct s | automatic s | cheapest per level s | its choices |")
+    print("|---|---|---|---|---|---|---|---|")
+    for key in sorted(usable):
+        v = usable[key]
+        n, P = key[0], key[2]
+        d = v["direct"]["decomposition"]
+        for name in ("infiniband", "ethernet25"):
+            net = NETWORKS[name]
+            total = lambda x: sum(level_cost(e, P, m, b, net) for _, e, m, b in v[x]["level_lines"])
+            byLevel = defaultdict(dict)
+            for x in ("direct", "chunked", "tree"):
+                for k, e, m, b in v[x]["level_lines"]:
+                    byLevel[k][e] = level_cost(e, P, m, b, net)
+            best = [min(byLevel[k].items(), key=lambda kv: kv[1]) for k in sorted(byLevel)]
+            print("| %.3gM | %s | %d | %s | %.5f | %.5f | %.5f | %s |" % (
+                n**3/1e6, NAMES.get(d, d), P, name, total("direct"), total("automatic"),
+                sum(c for _, c in best), "".join(e[0] if c > 0 else "-" for e, c in best)))
 
 
 def main(argv):
