@@ -114,21 +114,21 @@ def result_lines(paths):
 
 def read_records(paths):
     """{(n, decomposition): {ranks: record}} from mbaScaling RESULT lines; a
-    rank count recorded more than once counts by its record of median work
-    (benchmarks/scaling measures one rank three times per decomposition: every
-    efficiency's baseline, the median of all one-rank runs of the size)"""
+    rank count recorded more than once counts by its record of median work.
+    Decompositions into the same parts are the same computation (one rank,
+    1x1x1; two ranks, 2x1x1 for all three; 2x2x1 for boxes and columns on
+    four): their runs at a size are pooled (benchmarks/scaling measures one
+    rank three times per decomposition: every efficiency's baseline, the
+    median of all one-rank runs of the size)"""
     runs = defaultdict(lambda: defaultdict(list))
+    same = defaultdict(list)
     for rec in result_lines(paths):
         runs[(int(rec["n"]), rec["decomposition"])][int(rec["ranks"])].append(rec)
-    # one rank is the same computation whatever the decomposition: its runs
-    # at a size are pooled (benchmarks/scaling's three per decomposition)
-    single = defaultdict(list)
-    for (n, d), byRanks in runs.items():
-        single[n] += byRanks.get(1, [])
+        same[(int(rec["n"]), rec["parts"])].append(rec)
     out = defaultdict(dict)
     for key, byRanks in runs.items():
         for P, recs in byRanks.items():
-            recs = sorted(single[key[0]] if P == 1 else recs, key=lambda r: r["work_max"])
+            recs = sorted(same[(key[0], recs[0]["parts"])], key=lambda r: r["work_max"])
             out[key][P] = dict(recs[(len(recs) - 1)//2], decomposition=key[1])
     return out
 
