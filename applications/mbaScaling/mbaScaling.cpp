@@ -3,7 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
-//              [--control owner|balanced] [--replay]
+//              [--control owner|balanced] [--replay] [--per-rank]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -51,6 +51,10 @@
 // allocations contend. The plan and the figures of the communication are
 // the simulated run's; the RESULT line adds the simulated ranks' work
 // (simulated_work_max, _mean).
+//
+// --per-rank adds a line per rank: its control and evaluated points, and its
+// fit and evaluation work (with --replay, measured alone): where the work
+// of a decomposition sits.
 
 #include "multilevel.hpp"
 #include "recordedCommunicators.hpp"
@@ -87,6 +91,7 @@ struct options
     std::string exchangeName = "automatic";   ///< as given, for the RESULT line
     bool balanced = false;   ///< --control balanced
     bool replay = false;     ///< --replay
+    bool perRank = false;    ///< --per-rank
 };
 
 [[noreturn]] void usage(const std::string& msg)
@@ -97,7 +102,7 @@ struct options
     os <<
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
-        "                  [--control owner|balanced] [--replay]\n";
+        "                  [--control owner|balanced] [--replay] [--per-rank]\n";
     std::exit(msg.empty() ? 0 : 2);
 }
 
@@ -144,6 +149,7 @@ options parse(int argc, char** argv)
             else if (a == "--levels") o.levels = true;
             else if (a == "--lower-bound") o.lowerBound = true;
             else if (a == "--replay") o.replay = true;
+            else if (a == "--per-rank") o.perRank = true;
             else if (a == "--steps") o.steps = std::stoi(val());
             else if (a == "--exchange")
             {
@@ -568,6 +574,13 @@ int main(int argc, char** argv)
                                 static_cast<long long>(s.lonePoints),
                                 s.level < int(res.busiestLeast.size())
                                     ? (" " + std::to_string(std::llround(res.busiestLeast[s.level]))).c_str() : "");
+            }
+            if (o.perRank)
+            {
+                std::printf("  per rank: rank, control points, evaluated points, fit s, evaluation s\n");
+                for (int r = 0; r < P; ++r)
+                    std::printf("  %5d %8.0f %8.0f %9.6f %9.6f\n", r, v[r].control, v[r].evaluation, v[r].fitCpu,
+                                v[r].evalCpu);
             }
             std::fflush(stdout);
         }
