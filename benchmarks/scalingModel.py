@@ -88,14 +88,14 @@ def result_lines(paths):
     """The RESULT lines of mbaScaling's output files, each as a dict (numbers
     as floats); with mbaScaling --levels, "level_lines" holds the per-level lines
     that follow it (the rank receiving most: level, its exchange, messages
-    and bytes received)"""
+    and bytes received; a separated level's exchange is a direct one)"""
     for path in paths:
         rec = None
         with open(path) as f:
             for line in f:
                 w = line.split()
-                if rec is not None and len(w) >= 6 and w[0].isdigit() and w[1] in ("direct", "chunked", "tree"):
-                    rec["level_lines"].append((int(w[0]), w[1], int(w[4]), int(w[5])))
+                if rec is not None and len(w) >= 6 and w[0].isdigit() and w[1] in ("direct", "chunked", "tree", "separate"):
+                    rec["level_lines"].append((int(w[0]), "direct" if w[1] == "separate" else w[1], int(w[4]), int(w[5])))
                     continue
                 if not line.startswith("RESULT "):
                     continue
@@ -133,13 +133,18 @@ def read_records(paths):
     return out
 
 
+def exchange_time(rounds, messages, nbytes, net):
+    """Modelled seconds of exchange rounds: R alpha + M o + B / beta"""
+    return rounds*net["alpha"] + messages*net["o"] + nbytes/net["beta"]
+
+
 def comm_times(rec, P, net):
     """Modelled seconds of the busiest rank's communication a step: the
     levels' exchange (R alpha + M o + B / beta) and the all-gathers and
     reductions ((G + S) 2 ceil(log2 P) alpha)"""
     if P == 1:
         return 0.0, 0.0
-    return (rec["exchanges"]*net["alpha"] + rec["messages_max"]*net["o"] + rec["recv_bytes_max"]/net["beta"],
+    return (exchange_time(rec["exchanges"], rec["messages_max"], rec["recv_bytes_max"], net),
             (rec["all_gathers"] + SOLVER_REDUCTIONS)*2*math.ceil(math.log2(P))*net["alpha"])
 
 
@@ -241,7 +246,7 @@ def level_cost(exchange, P, messages, nbytes, net):
         return 0.0
     rounds = {"direct": 1, "chunked": 2,
               "tree": 2*math.ceil(math.log2(P)) + (2 if P & (P - 1) else 0)}[exchange]
-    return rounds*net["alpha"] + messages*net["o"] + nbytes/net["beta"]
+    return exchange_time(rounds, messages, nbytes, net)
 
 
 def cheapest_per_level(rows):
