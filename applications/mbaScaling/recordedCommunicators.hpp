@@ -8,6 +8,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -62,6 +63,15 @@ protected:
         return timed([&] {
             std::vector<bytes> all = inner_.allGather(mine);
             record(all);
+            return all;
+        });
+    }
+    bytes allGatherFixedBytes(const bytes& mine) const override
+    {
+        ++gathers_;
+        return timed([&] {
+            bytes all = inner_.allGatherFixed(mine);
+            record({all});
             return all;
         });
     }
@@ -132,6 +142,14 @@ protected:
     {
         const std::vector<bytes>& all = next();
         if (all.at(rank_) != mine) throw std::logic_error("mbaScaling: the replay departs from the run");
+        return all;
+    }
+    bytes allGatherFixedBytes(const bytes& mine) const override
+    {
+        const bytes& all = next().at(0);
+        if (all.size() != std::size_t(size_)*mine.size()
+            || !std::equal(mine.begin(), mine.end(), all.begin() + std::ptrdiff_t(std::size_t(rank_)*mine.size())))
+            throw std::logic_error("mbaScaling: the replay departs from the run");
         return all;
     }
     std::vector<bytes> exchangeBytes(const std::vector<bytes>&) const override { return next(); }

@@ -59,8 +59,30 @@ void communicator::sendReceiveBytes(int to, constByteRange send, int from, byteR
     exchangeInPlace(s, r);
 }
 
+bytes communicator::allGatherFixedBytes(const bytes& mine) const
+{
+    const int P = size(), me = rank();
+    const std::size_t nb = mine.size();
+    // got holds the blocks of ranks me, me + 1, ... (mod P); each round
+    // doubles them with the first ones of rank me + have, whose are next
+    bytes got(std::size_t(P)*nb);
+    if (nb) std::memcpy(got.data(), mine.data(), nb);
+    for (int have = 1; have < P; have *= 2)
+    {
+        const std::size_t n = std::size_t(std::min(have, P - have))*nb;
+        sendReceiveBytes((me - have + P)%P, constByteRange{got.data(), n},
+                         (me + have)%P, byteRange{got.data() + std::size_t(have)*nb, n});
+    }
+    // rank r's block is at (r - me) mod P: rank 0's first
+    std::rotate(got.begin(), got.begin() + std::ptrdiff_t(std::size_t((P - me)%P)*nb), got.end());
+    return got;
+}
+
 void communicator::check(bool ok, const std::string& msg) const
 {
+    // whether any rank failed, in one all-gather of known size; the
+    // messages only then
+    if (max(ok ? 0.0 : 1.0) == 0) return;
     bytes mine;
     if (!ok) mine.assign(msg.begin(), msg.end()), mine.push_back('\0');
     const auto all = allGather(mine);

@@ -66,6 +66,13 @@ protected:
     /// number of times; an implementation may let a rank without partners
     /// return at once. By default through exchangeInPlace.
     virtual void sendReceiveBytes(int to, constByteRange send, int from, byteRange recv) const;
+    /// Every rank's mine, whose size is the same on every rank (the
+    /// caller's promise: a rank that passes another size is an error of
+    /// the transport), concatenated in rank order. By default the Bruck
+    /// all-gather over sendReceiveBytes: ceil(log2 P) rounds of one
+    /// message each way (a gather and a scatter over a tree take twice
+    /// as many), carrying nothing but the values.
+    virtual bytes allGatherFixedBytes(const bytes& mine) const;
 
 private:
     /// Every rank's values as bytes (counted as collective traffic)
@@ -98,19 +105,15 @@ public:
     /// allGather of the same number of values from every rank, as one
     /// array: rank r's n = mine.size() values at [r n, (r + 1) n). One
     /// array, not one a rank: for the few values a rank adds to a sum or
-    /// a maximum. Throws collectiveError where the ranks' sizes differ
+    /// a maximum. Every rank must pass the same n (allGatherFixedBytes)
     template <class T>
     std::vector<T> allGatherFixed(const std::vector<T>& mine) const
     {
-        const std::size_t nb = mine.size()*sizeof(T);
-        const std::vector<bytes> all = allGatherOf(mine);
-        std::vector<T> out(all.size()*mine.size());
-        for (std::size_t r = 0; r < all.size(); ++r)
-        {
-            if (all[r].size() != nb) throw collectiveError("mba: an all-gather of arrays of different sizes");
-            if (nb) std::memcpy(reinterpret_cast<char*>(out.data()) + r*nb, all[r].data(), nb);
-        }
-        return out;
+        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
+        bytes b(mine.size()*sizeof(T));
+        if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
+        traffic_.collectiveBytes += b.size();
+        return fromBytes<T>(allGatherFixedBytes(b));
     }
 
     template <class T>

@@ -51,6 +51,18 @@ inline void communicatorConformance(const mba::communicator& comm)
         for (const auto& v : none) BSM_CHECK(v.empty());
     }
 
+    // all-gather of one size on every rank (allGatherFixed), of 0, 1 and 3
+    // values a rank: rank r's at [r n, (r + 1) n), the bits it sent
+    for (const int n : {0, 1, 3})
+    {
+        std::vector<double> mine(n);
+        for (int i = 0; i < n; ++i) mine[i] = me + 1.0/3 + 1e-3*i;
+        const std::vector<double> all = comm.allGatherFixed(mine);
+        BSM_REQUIRE(all.size() == std::size_t(P*n));
+        for (int r = 0; r < P; ++r)
+            for (int i = 0; i < n; ++i) BSM_CHECK(all[r*n + i] == r + 1.0/3 + 1e-3*i);
+    }
+
     // reductions: exact values, identical on every rank (collectives are
     // called outside the assertions: those take turns)
     {

@@ -50,7 +50,8 @@ TEST_CASE("communicator conformance: serial", "[parallel][conformance]")
 
 TEST_CASE("communicator conformance: simulated ranks", "[parallel][conformance]")
 {
-    const int P = GENERATE(1, 2, 3, 5);
+    // (3, 5, 6, 7 and 13: the all-gather's last round carries fewer blocks than it holds)
+    const int P = GENERATE(1, 2, 3, 4, 5, 6, 7, 8, 13);
     runSimulated(P, [](const communicator& comm) { communicatorConformance(comm); });
 }
 

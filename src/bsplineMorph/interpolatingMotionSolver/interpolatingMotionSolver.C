@@ -284,7 +284,8 @@ void Foam::interpolatingMotionSolver::plan
     const bool changed
 )
 {
-    if (returnReduce(changed, orOp<bool>()) || !interpolator)
+    // (the communicator's all-gather: ceil(log2 N) latencies, a tree's 2 log2 N)
+    if (comm_.max(changed ? 1 : 0) > 0 || !interpolator)
     {
         if (!refit)
         {

@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "sumsAndMaxima.H"
+#include "PstreamCommunicator.H"
 #include "Pstream.H"
 
 // * * * * * * * * * * * * * * * Global Functions  * * * * * * * * * * * * * //
@@ -27,31 +28,25 @@ void Foam::sumsAndMaxima(UList<scalar>& sums, UList<scalar>& maxima)
         return;
     }
     const label nSums = sums.size();
-    scalarList values(nSums + maxima.size());
+    const std::size_t n = nSums + maxima.size();
+    std::vector<double> mine(n);
+    std::copy(sums.begin(), sums.end(), mine.begin());
+    std::copy(maxima.begin(), maxima.end(), mine.begin() + nSums);
+    const std::vector<double> all = PstreamCommunicator().allGatherFixed(mine);
     forAll(sums, i)
     {
-        values[i] = sums[i];
+        sums[i] = 0;
     }
-    forAll(maxima, i)
+    for (std::size_t at = 0; at < all.size(); at += n)
     {
-        values[nSums + i] = maxima[i];
-    }
-    const auto combine = [nSums](scalarList& x, const scalarList& y)
-    {
-        forAll(x, i)
+        forAll(sums, i)
         {
-            x[i] = i < nSums ? x[i] + y[i] : max(x[i], y[i]);
+            sums[i] += all[at + i];
         }
-    };
-    Pstream::combineGather(values, combine);
-    Pstream::combineScatter(values);
-    forAll(sums, i)
-    {
-        sums[i] = values[i];
-    }
-    forAll(maxima, i)
-    {
-        maxima[i] = values[nSums + i];
+        forAll(maxima, i)
+        {
+            maxima[i] = max(maxima[i], all[at + nSums + i]);
+        }
     }
 }
 
