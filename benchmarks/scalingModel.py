@@ -14,7 +14,7 @@ all-gathers of a step.
 
 The model of one step on P ranks:
 
-    T(P) = W(P) + R alpha + M o + B / beta + (G + F) ceil(log2 P) alpha + S 2 ceil(log2 P) alpha
+    T(P) = W(P) + R alpha + M o + B / beta + (G + S) ceil(log2 P) alpha
 
 W: the busiest rank's work (fit and evaluation), measured alone (above); R: exchange rounds
 (one a direct level, two a chunked one, 2 log2 P a tree one, two more where P
@@ -23,14 +23,12 @@ together); M, B: messages and bytes the busiest rank receives (o: the
 receiver's overhead per message, beta: the bandwidth); G: the core's
 all-gathers a step (the residual each level, the values' check and maximum,
 the affine start's sums: all of one size on every rank, each ceil(log2 P)
-rounds of the communicator's all-gather); F: the motion solver's reductions
-through the same all-gather (the control set's counts, the fit's figures
-for the log line, the inverted-cell check's counts: sumsAndMaxima; whether
-the control set changed); S: its reductions through OpenFOAM's gather and
-scatter over a tree, 2 log2 P latencies (the prescribed values'
-finiteness: the names of the patches with non-finite values). F and S are
-counted in the code (SOLVER_GATHERS, SOLVER_TREES: a 3D case without rigid
-layers, which adds its own). Efficiency: T(1)/(P T(P)).
+rounds of the communicator's all-gather); S: the motion solver's own
+reductions a step, through the same all-gather (SOLVER_REDUCTIONS, counted
+in the code: whether any prescribed value is not finite, the control set's
+counts, whether the control set changed, the fit's figures for the log
+line, the inverted-cell check's counts: a 3D case without rigid layers,
+which adds its own). Efficiency: T(1)/(P T(P)).
 Networks (stated, not measured):
 
     infiniband  alpha 2 us,  o 0.5 us, beta 10 GB/s  (HDR/EDR-class)
@@ -78,10 +76,8 @@ ORDER = {"simple": 0, "hierarchical": 1, "columns": 2}
 EXCHANGES = ["direct", "chunked", "tree", "automatic"]
 
 # The motion solver's reductions a step outside the core (interpolatingMotionSolver
-# with multilevelBSpline, a 3D case without rigid layers; see the header): through
-# the communicator's all-gather, and through OpenFOAM's trees
-SOLVER_GATHERS = 4
-SOLVER_TREES = 1
+# with multilevelBSpline, a 3D case without rigid layers; see the header)
+SOLVER_REDUCTIONS = 5
 
 NETWORKS = {
     "infiniband": dict(alpha=2e-6, o=0.5e-6, beta=10e9),
@@ -147,11 +143,11 @@ def exchange_time(rounds, messages, nbytes, net):
 def comm_times(rec, P, net):
     """Modelled seconds of the busiest rank's communication a step: the
     levels' exchange (R alpha + M o + B / beta) and the all-gathers and
-    reductions ((G + F) ceil(log2 P) alpha + S 2 ceil(log2 P) alpha)"""
+    reductions ((G + S) ceil(log2 P) alpha)"""
     if P == 1:
         return 0.0, 0.0
     return (exchange_time(rec["exchanges"], rec["messages_max"], rec["recv_bytes_max"], net),
-            (rec["all_gathers"] + SOLVER_GATHERS + 2*SOLVER_TREES)*math.ceil(math.log2(P))*net["alpha"])
+            (rec["all_gathers"] + SOLVER_REDUCTIONS)*math.ceil(math.log2(P))*net["alpha"])
 
 
 def step_time(rec, P, net):

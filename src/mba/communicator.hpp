@@ -2,8 +2,9 @@
 // The small communication interface the distributed algorithm is written against.
 //
 // Implementations provide rank/size and two byte-level collectives; typed
-// helpers, reductions (summed in rank order, so every rank gets bitwise the
-// same result) and the collective check are built on them here, once.
+// helpers, the all-gather of one size (over point-to-point rounds),
+// reductions (summed in rank order, so every rank gets bitwise the same
+// result) and the collective check are built on them here, once.
 #ifndef MBA_COMMUNICATOR_HPP
 #define MBA_COMMUNICATOR_HPP
 

@@ -269,12 +269,18 @@ void Foam::boundaryConstraints::checkPrescribed
 {
     const polyMesh& mesh = pMesh_();
 
+    // Whether any rank has either kind of value, in one reduction; the
+    // patches' names are gathered only then
+    scalarList none;
+    scalarList any({scalar(nonFinite.size()), scalar(emptyDirection.size())});
+    sumsAndMaxima(none, any);
+
     // Non-finite values stop everything here, on every rank, before they
     // reach any arithmetic (with FOAM_SIGFPE a NaN comparison traps)
-    Pstream::combineGather(nonFinite, HashSetOps::plusEqOp<word>());
-    Pstream::combineScatter(nonFinite);
-    if (nonFinite.size())
+    if (any[0] > 0)
     {
+        Pstream::combineGather(nonFinite, HashSetOps::plusEqOp<word>());
+        Pstream::combineScatter(nonFinite);
         FatalErrorInFunction
             << "pointDisplacement has non-finite (NaN or Inf) or huge (over 1e8"
             << " times the mesh's bounding-box diagonal) values on patches "
@@ -284,9 +290,9 @@ void Foam::boundaryConstraints::checkPrescribed
     }
 
     // A 2D case moves in its plane: a prescribed component out of it is
-    // dropped, with a warning (once per patch; a 3D case has none to
-    // gather, on any rank)
-    if (frame_->size() == 3)
+    // dropped, with a warning (once per patch; a 3D case has none, on any
+    // rank)
+    if (any[1] == 0)
     {
         return;
     }
