@@ -76,15 +76,16 @@ protected:
     virtual bytes allGatherFixedBytes(const bytes& mine) const;
 
 private:
-    /// Every rank's values as bytes (counted as collective traffic)
+    /// This rank's values as the bytes it contributes to an all-gather
+    /// (counted as collective traffic)
     template <class T>
-    std::vector<bytes> allGatherOf(const std::vector<T>& mine) const
+    bytes collectiveBytesOf(const std::vector<T>& mine) const
     {
         static_assert(std::is_trivially_copyable<T>::value, "plain data only");
         bytes b(mine.size()*sizeof(T));
         if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
         traffic_.collectiveBytes += b.size();
-        return allGatherBytes(b);
+        return b;
     }
 
 public:
@@ -97,7 +98,7 @@ public:
     template <class T>
     std::vector<std::vector<T>> allGather(const std::vector<T>& mine) const
     {
-        const std::vector<bytes> all = allGatherOf(mine);
+        const std::vector<bytes> all = allGatherBytes(collectiveBytesOf(mine));
         std::vector<std::vector<T>> out(all.size());
         for (std::size_t r = 0; r < all.size(); ++r) out[r] = fromBytes<T>(all[r]);
         return out;
@@ -110,11 +111,7 @@ public:
     template <class T>
     std::vector<T> allGatherFixed(const std::vector<T>& mine) const
     {
-        static_assert(std::is_trivially_copyable<T>::value, "plain data only");
-        bytes b(mine.size()*sizeof(T));
-        if (!b.empty()) std::memcpy(b.data(), mine.data(), b.size());
-        traffic_.collectiveBytes += b.size();
-        return fromBytes<T>(allGatherFixedBytes(b));
+        return fromBytes<T>(allGatherFixedBytes(collectiveBytesOf(mine)));
     }
 
     template <class T>
