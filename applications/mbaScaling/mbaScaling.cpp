@@ -3,7 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
-//              [--control owner|balanced] [--replay] [--per-rank]
+//              [--control owner|balanced|local] [--replay] [--per-rank]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -22,6 +22,12 @@
 // the fit costs when the control points are spread evenly over the ranks
 // (a rank's cells' points of the top and bottom are then another rank's
 // control points: prescribed, not evaluated, as in the motion solver).
+// --control local hands half of a wall box's control points to the box next
+// to it along z (boxes of at least three parts along z; otherwise as owner):
+// the box at the bottom keeps the points of its cells in the lower half of
+// its x range and hands the others to the box above it, the box at the top
+// to the box below it: the control points spread over twice as many ranks,
+// each next to the rank whose cells hold them.
 //
 // Per rank count: the plan and a first fit, then a step measured (a fit
 // through the plan with new values, and the evaluation; the median of --steps, whose CPU times
@@ -89,7 +95,7 @@ struct options
     int steps = 1;
     params::exchangeMode exchange = params::exchangeMode::automatic;
     std::string exchangeName = "automatic";   ///< as given, for the RESULT line
-    bool balanced = false;   ///< --control balanced
+    std::string control = "owner";   ///< --control: owner, balanced or local
     bool replay = false;     ///< --replay
     bool perRank = false;    ///< --per-rank
 };
@@ -102,7 +108,7 @@ struct options
     os <<
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
-        "                  [--control owner|balanced] [--replay] [--per-rank]\n";
+        "                  [--control owner|balanced|local] [--replay] [--per-rank]\n";
     std::exit(msg.empty() ? 0 : 2);
 }
 
@@ -163,9 +169,9 @@ options parse(int argc, char** argv)
             }
             else if (a == "--control")
             {
-                const std::string c = val();
-                if (c != "owner" && c != "balanced") usage("--control must be owner or balanced");
-                o.balanced = c == "balanced";
+                o.control = val();
+                if (o.control != "owner" && o.control != "balanced" && o.control != "local")
+                    usage("--control must be owner, balanced or local");
             }
             else usage("unknown option " + a);
         }
@@ -175,11 +181,11 @@ options parse(int argc, char** argv)
         usage("--decomposition must be simple, hierarchical or columns");
     if (o.n < 2) usage("--n must be at least 2");
     if (o.steps < 1) usage("--steps must be at least 1");
-    if (o.balanced && o.lowerBound) usage("--lower-bound counts the cells' owners: not with --control balanced");
+    if (o.control != "owner" && o.lowerBound) usage("--lower-bound counts the cells' owners: only with --control owner");
     for (int p : o.ranks)
     {
         if (p < 1) usage("rank counts must be positive");
-        if (o.balanced && p % 2) usage("--control balanced needs even rank counts");
+        if (o.control == "balanced" && p % 2) usage("--control balanced needs even rank counts");
         for (int m : parts(p, o.decomposition))
             if (m > o.n) usage("rank count " + std::to_string(p) + " splits a direction into more parts than cells");
     }
@@ -368,7 +374,7 @@ rankResult runRanks(const options& o, int P)
             const point<3> d = displacement(x);
             for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }
         };
-        if (o.balanced)
+        if (o.control == "balanced")
         {
             // plane p's points (bottom, top) to ranks p P/2 ... (p + 1) P/2 - 1,
             // in a x b blocks as `columns` splits P/2
@@ -389,8 +395,28 @@ rankResult runRanks(const options& o, int P)
                 {
                     const point<3> x{double(i)/n, double(j)/n, double(k)/n};
                     if (k != 0 && k != n) eval.push_back(x);
-                    else if (!o.balanced && owner(i, j, k) == r) addControl(x);
+                    else if (o.control == "owner" && owner(i, j, k) == r) addControl(x);
                 }
+        if (o.control == "local")
+        {
+            // a wall box keeps its points in the lower half of its x range,
+            // the box next to it along z takes the others
+            for (const long k : {0L, n})
+                for (long j = 0; j <= n; ++j)
+                    for (long i = 0; i <= n; ++i)
+                    {
+                        const int q = owner(i, j, k);
+                        const int qx = q % m[0], qy = (q/m[0]) % m[1], qz = q/(m[0]*m[1]);
+                        const long a = first(qx, n, m[0]), b = first(qx + 1, n, m[0]);
+                        int to = q;
+                        if (m[2] > 2 && 2*(i - a) > (b - a))
+                        {
+                            const int nz = qz == 0 ? 1 : qz - 1;
+                            to = qx + m[0]*(qy + m[1]*nz);
+                        }
+                        if (to == r) addControl(point<3>{double(i)/n, double(j)/n, double(k)/n});
+                    }
+        }
         std::set<int> nb;
         for (int q = 0; q < P; ++q)
         {
@@ -505,7 +531,9 @@ int main(int argc, char** argv)
     std::printf("mbaScaling: twisted cube, %ld^3 cells, %ld control points (top and bottom), %ld evaluated points, "
                 "decomposition %s, control points %s\n", n, nControl,
                 (n + 1)*(n + 1)*(n + 1) - nControl,
-                o.decomposition.c_str(), o.balanced ? "in balanced blocks (--control balanced)" : "of their cells' ranks");
+                o.decomposition.c_str(), o.control == "balanced" ? "in balanced blocks (--control balanced)"
+                : o.control == "local" ? "shared by the wall boxes with the boxes next to them (--control local)"
+                : "of their cells' ranks");
     std::printf("per step (a fit through the plan and the evaluation); share: 48 bytes per control point of the "
                 "rank's mean share of the boundary\n\n");
     std::printf("%5s %9s %8s %8s %11s %11s %8s %6s %6s %5s %9s %9s %9s %9s %8s\n", "ranks", "parts", "ctrl max",
@@ -550,7 +578,7 @@ int main(int argc, char** argv)
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
                         "plan_cpu_max=%.4f max_residual=%.17g lower_bound_max=%.0f work_measured=%s%s\n",
-                        n, o.decomposition.c_str(), o.exchangeName.c_str(), o.balanced ? "balanced" : "owner", P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
+                        n, o.decomposition.c_str(), o.exchangeName.c_str(), o.control.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
                         res.maxResidual, bound.max, o.replay ? "alone" : "simulated",
