@@ -374,49 +374,33 @@ rankResult runRanks(const options& o, int P)
             const point<3> d = displacement(x);
             for (int c = 0; c < 3; ++c) { v1.push_back(0.5*d[c]); v2.push_back(d[c]); }
         };
-        if (o.control == "balanced")
-        {
-            // plane p's points (bottom, top) to ranks p P/2 ... (p + 1) P/2 - 1,
-            // in a x b blocks as `columns` splits P/2
-            const std::array<int, 3> bm = parts(P/2, "columns");
-            for (const long k : {0L, n})
-                for (long j = 0; j <= n; ++j)
-                    for (long i = 0; i <= n; ++i)
-                    {
-                        const long a = std::min<long>(bm[0] - 1, i*bm[0]/(n + 1));
-                        const long b = std::min<long>(bm[1] - 1, j*bm[1]/(n + 1));
-                        if ((k == n)*(P/2) + a + bm[0]*b == r)
-                            addControl(point<3>{double(i)/n, double(j)/n, double(k)/n});
-                    }
-        }
-        for (long k = lo[2]; k <= hi[2]; ++k)
+        // the rank that fits face point (i, j, k), as --control assigns it
+        const std::array<int, 3> bm = parts(std::max(1, P/2), "columns");
+        auto fitter = [&](long i, long j, long k) {
+            if (o.control == "balanced")
+            {
+                // plane p's points (bottom, top) to ranks p P/2 ... (p + 1)
+                // P/2 - 1, in a x b blocks as `columns` splits P/2
+                const long a = std::min<long>(bm[0] - 1, i*bm[0]/(n + 1));
+                const long b = std::min<long>(bm[1] - 1, j*bm[1]/(n + 1));
+                return int((k == n)*(P/2) + a + bm[0]*b);
+            }
+            const int q = owner(i, j, k);
+            if (o.control == "owner" || m[2] <= 2) return q;
+            // local: a wall box keeps its points in the lower half of its x
+            // range, the box next to it along z takes the others
+            const int qx = q % m[0], qy = (q/m[0]) % m[1], qz = q/(m[0]*m[1]);
+            const long a = first(qx, n, m[0]), b = first(qx + 1, n, m[0]);
+            return 2*(i - a) > b - a ? qx + m[0]*(qy + m[1]*(qz == 0 ? 1 : qz - 1)) : q;
+        };
+        for (const long k : {0L, n})
+            for (long j = 0; j <= n; ++j)
+                for (long i = 0; i <= n; ++i)
+                    if (fitter(i, j, k) == r) addControl(point<3>{double(i)/n, double(j)/n, double(k)/n});
+        for (long k = std::max(lo[2], 1L); k <= std::min(hi[2], n - 1); ++k)
             for (long j = lo[1]; j <= hi[1]; ++j)
                 for (long i = lo[0]; i <= hi[0]; ++i)
-                {
-                    const point<3> x{double(i)/n, double(j)/n, double(k)/n};
-                    if (k != 0 && k != n) eval.push_back(x);
-                    else if (o.control == "owner" && owner(i, j, k) == r) addControl(x);
-                }
-        if (o.control == "local")
-        {
-            // a wall box keeps its points in the lower half of its x range,
-            // the box next to it along z takes the others
-            for (const long k : {0L, n})
-                for (long j = 0; j <= n; ++j)
-                    for (long i = 0; i <= n; ++i)
-                    {
-                        const int q = owner(i, j, k);
-                        const int qx = q % m[0], qy = (q/m[0]) % m[1], qz = q/(m[0]*m[1]);
-                        const long a = first(qx, n, m[0]), b = first(qx + 1, n, m[0]);
-                        int to = q;
-                        if (m[2] > 2 && 2*(i - a) > (b - a))
-                        {
-                            const int nz = qz == 0 ? 1 : qz - 1;
-                            to = qx + m[0]*(qy + m[1]*nz);
-                        }
-                        if (to == r) addControl(point<3>{double(i)/n, double(j)/n, double(k)/n});
-                    }
-        }
+                    eval.push_back(point<3>{double(i)/n, double(j)/n, double(k)/n});
         std::set<int> nb;
         for (int q = 0; q < P; ++q)
         {
