@@ -3,7 +3,7 @@
 //
 //   mbaScaling [--n N] [--ranks "P1 P2 ..."] [--decomposition simple|hierarchical|columns]
 //              [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]
-//              [--control owner|balanced|local] [--replay] [--per-rank]
+//              [--control owner|balanced|local] [--replay [--cold]] [--per-rank]
 //
 // The mesh is the twisted cube of tutorials/twistedCube: the unit cube in N^3
 // cells (default 100: 1M cells), its (N+1)^3 points. The control points are
@@ -58,6 +58,14 @@
 // the simulated run's; the RESULT line adds the simulated ranks' work
 // (simulated_work_max, _mean).
 //
+// --cold (with --replay) empties the caches before each replayed step:
+// the rank streams through a buffer twice the size of the last-level cache
+// (sysconf; at least 64 MiB), outside the measured time. The motion solver's
+// step follows the flow solver's, which has gone through all of its fields
+// and left little of the morpher's data in the caches; without it a replayed
+// rank whose data are a few MB finds them in the cache from its previous
+// step, as a rank on a node whose cores share that cache would not.
+//
 // --per-rank adds a line per rank: its control and evaluated points, and its
 // fit and evaluation work (with --replay, measured alone): where the work
 // of a decomposition sits.
@@ -81,6 +89,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 using namespace mba;
 
 namespace {
@@ -98,6 +108,7 @@ struct options
     std::string control = "owner";   ///< --control: owner, balanced or local
     bool replay = false;     ///< --replay
     bool perRank = false;    ///< --per-rank
+    bool cold = false;       ///< --cold
 };
 
 [[noreturn]] void usage(const std::string& msg)
@@ -108,7 +119,7 @@ struct options
     os <<
         "usage: mbaScaling [--n N] [--ranks \"P1 P2 ...\"] [--decomposition simple|hierarchical|columns]\n"
         "                  [--levels] [--steps S] [--lower-bound] [--exchange automatic|direct|chunked|tree]\n"
-        "                  [--control owner|balanced|local] [--replay] [--per-rank]\n";
+        "                  [--control owner|balanced|local] [--replay [--cold]] [--per-rank]\n";
     std::exit(msg.empty() ? 0 : 2);
 }
 
@@ -156,6 +167,7 @@ options parse(int argc, char** argv)
             else if (a == "--lower-bound") o.lowerBound = true;
             else if (a == "--replay") o.replay = true;
             else if (a == "--per-rank") o.perRank = true;
+            else if (a == "--cold") o.cold = true;
             else if (a == "--steps") o.steps = std::stoi(val());
             else if (a == "--exchange")
             {
@@ -190,7 +202,27 @@ options parse(int argc, char** argv)
             if (m > o.n) usage("rank count " + std::to_string(p) + " splits a direction into more parts than cells");
     }
     if (o.ranks.empty()) usage("--ranks needs at least one rank count");
+    if (o.cold && !o.replay) usage("--cold empties the caches before each replayed step: only with --replay");
     return o;
+}
+
+/// Empties the caches (--cold): reads one byte a cache line of a
+/// buffer twice the last-level cache's size, at least 64 MiB
+void evictCaches()
+{
+    static std::vector<unsigned char> buffer;
+    if (buffer.empty())
+    {
+        long llc = 0;
+#ifdef _SC_LEVEL3_CACHE_SIZE
+        llc = std::max(sysconf(_SC_LEVEL3_CACHE_SIZE), sysconf(_SC_LEVEL2_CACHE_SIZE));
+#endif
+        buffer.assign(std::size_t(std::max(2*llc, 64L << 20)), 1);
+    }
+    unsigned sum = 0;
+    for (std::size_t i = 0; i < buffer.size(); i += 64) sum += buffer[i];
+    static volatile unsigned sink;
+    sink = sum;
 }
 
 /// The twisted cube's top and bottom at t = 1: displacement of the point x
@@ -428,6 +460,7 @@ rankResult runRanks(const options& o, int P)
         std::vector<double> fitSteps, evalSteps;
         for (int step = 0; step < o.steps; ++step)
         {
+            if (replayed && o.cold) evictCaches();
             double c = comm.seconds();
             t = threadSeconds();
             mba.fit(step % 2 ? v1 : v2);
@@ -561,11 +594,11 @@ int main(int argc, char** argv)
                         "messages_per_neighbour_level_max=%.3f collective_bytes=%.0f all_gathers=%.0f exchanges=%.0f "
                         "fit_cpu_max=%.6f "
                         "fit_cpu_mean=%.6f eval_cpu_max=%.6f eval_cpu_mean=%.6f work_max=%.6f work_mean=%.6f "
-                        "plan_cpu_max=%.4f max_residual=%.17g lower_bound_max=%.0f work_measured=%s%s\n",
+                        "plan_cpu_max=%.4f max_residual=%.17g lower_bound_max=%.0f work_measured=%s caches=%s%s\n",
                         n, o.decomposition.c_str(), o.exchangeName.c_str(), o.control.c_str(), P, pstr.c_str(), res.levels, nControl, ctrl.max, ctrl.mean,
                         eval.max, eval.mean, nb.max, bytes.max, bytes.mean, share, msgs.max, msgs.mean, perNb.max,
                         coll.max, gathers.max, exchanges.max, fit.max, fit.mean, ev.max, ev.mean, work.max, work.mean, plan.max,
-                        res.maxResidual, bound.max, o.replay ? "alone" : "simulated",
+                        res.maxResidual, bound.max, o.replay ? "alone" : "simulated", o.cold ? "cold" : "warm",
                         o.replay ? (" simulated_work_max=" + std::to_string(simulated.max) + " simulated_work_mean="
                                     + std::to_string(simulated.mean)).c_str() : "");
             if (o.lowerBound && P > 1)
