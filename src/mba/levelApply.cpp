@@ -477,7 +477,7 @@ void levelApplier<D>::exchangeInTree(levelPlan<D>& L)
     };
     for (const std::int64_t id : L.ownInView)
         if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(ph, ph + nc, v); });
-    treeSum(comm_, sums, send_, recv_);
+    treeSum(comm_, sums, chunkSum_);
     std::fill(L.phi.begin(), L.phi.end(), 0.0);
     for (std::int64_t id = 0; id < std::int64_t(L.treeStart.size()); ++id)
         if (L.treeStart[id] >= 0) forNodes(id, [nc](double* ph, double* v) { std::copy(v, v + nc, ph); });

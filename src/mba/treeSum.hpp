@@ -16,18 +16,19 @@
 
 namespace mba {
 
-/// One round of the tree as one rank takes part in it: the whole vector
-/// goes to the ranks to[] and the vectors of the ranks from[] arrive, added
-/// in order when add (else stored); -1: no partner
+/// One round of the tree as one rank takes part in it: v[sendBegin,
+/// sendEnd) goes to rank sendTo and rank recvFrom's values arrive in
+/// v[recvBegin, recvEnd), added when add (else stored); -1: no partner
 struct treeRound
 {
-    int to[2] = {-1, -1}, from[2] = {-1, -1};
+    int sendTo = -1, recvFrom = -1;
+    std::size_t sendBegin = 0, sendEnd = 0, recvBegin = 0, recvEnd = 0;
     bool add = false;
 };
 
-/// The rounds of the sum over P ranks as rank me takes part in them: every
-/// rank has as many (empty ones where it waits)
-std::vector<treeRound> treeRounds(int P, int me);
+/// The rounds of the sum of n values over P ranks as rank me takes part in
+/// them: every rank has as many (empty ones where it waits)
+std::vector<treeRound> treeRounds(int P, int me, std::size_t n);
 
 /// What rank me sends and receives in the rounds of the sum of n values
 /// over P ranks (messages: the non-empty ones)
@@ -39,10 +40,8 @@ struct treeTraffic
 treeTraffic treeTrafficOf(int P, int me, std::size_t n);
 
 /// v (the same size on every rank) summed over the ranks, in place, through
-/// treeRounds (communicator::exchange); send and recv are kept by the
-/// caller. Collective.
-void treeSum(const communicator& comm, std::vector<double>& v, std::vector<std::vector<double>>& send,
-             std::vector<std::vector<double>>& recv);
+/// treeRounds (communicator::sendReceive); work is kept by the caller. Collective.
+void treeSum(const communicator& comm, std::vector<double>& v, std::vector<double>& work);
 
 } // namespace mba
 #endif

@@ -129,11 +129,11 @@ TEST_CASE("tree sum: the same bits on every rank, one message a round", "[parall
             a[i] = double((i + 1)*(comm.rank() + 1));   // sums exact in any order
             b[i] = u(rng)*std::pow(10.0, int(rng() % 9) - 4);   // sums that depend on the order
         }
-        std::vector<std::vector<double>> send, recv;
+        std::vector<double> work;
         const std::uint64_t before = comm.traffic().messagesReceived;
-        treeSum(comm, a, send, recv);
+        treeSum(comm, a, work);
         received[comm.rank()] = comm.traffic().messagesReceived - before;
-        treeSum(comm, b, send, recv);
+        treeSum(comm, b, work);
         exact[comm.rank()] = a;
         rounded[comm.rank()] = b;
     });
