@@ -28,7 +28,14 @@ void Foam::sphereIndentationDisplacementPointPatchVectorField::readSphere
 )
 {
     centre_ = dict.get<point>("centre");
-    radius_ = dict.getCheck<scalar>("radius", scalarMinMax::ge(VSMALL));
+    radius_ = dict.get<scalar>("radius");
+    if (!(radius_ > 0))
+    {
+        FatalIOErrorInFunction(dict)
+            << "Entry 'radius' is " << radius_ << " on patch "
+            << patch().name() << ": the sphere's radius must be > 0"
+            << exit(FatalIOError);
+    }
     direction_ = dict.get<vector>("direction");
     if (mag(direction_) < VSMALL)
     {
