@@ -334,6 +334,12 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     // affine start then fits what the sampled spline leaves)
     params_.affine = start != initialApproximation::none;
     trendGrid_ = 0;
+    if (dict.found("thinPlateSplineCoeffs") && !dict.isDict("thinPlateSplineCoeffs"))
+    {
+        FatalIOErrorInFunction(dict)
+            << "thinPlateSplineCoeffs must be a dictionary { grid ...; level"
+            << " ...; }" << exit(FatalIOError);
+    }
     if (start == initialApproximation::thinPlateSpline)
     {
         // (its entries only: none falls back to the enclosing dictionary)
