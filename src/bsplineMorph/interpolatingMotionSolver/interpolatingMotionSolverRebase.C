@@ -91,6 +91,26 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     const bool found = io.typeHeaderOk<pointVectorField>(true);
     if (!returnReduce(found, orOp<bool>()))
     {
+        // (a run that rebased writes its base at every later write time: on
+        // a mesh that has moved since the initial one, say what is morphed)
+        bool moved = false;
+        const pointField& p = mesh().points();
+        const pointField& p0 = points0();
+        forAll(p, pointi)
+        {
+            if (p[pointi] != p0[pointi])
+            {
+                moved = true;
+                break;
+            }
+        }
+        if (returnReduce(moved, orOp<bool>()))
+        {
+            Info<< type << ": rebase on, no " << morphBaseName << " in "
+                << runTime.timeName() << ": morphing from the initial mesh"
+                << " (as a run that has not rebased before "
+                << runTime.timeName() << " does)" << endl;
+        }
         return;
     }
     if (!returnReduce(found, andOp<bool>()))
@@ -99,7 +119,10 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
             << "rebase on: the morph's base " << morphBaseName << " is in "
             << runTime.timeName() << " of some ranks' directories only ("
             << (found ? "found" : "not found") << " in "
-            << runTime.relativePath(io.objectPath()).c_str() << "): decompose"
+            << runTime.relativePath
+               (
+                   found ? io.localFilePath(pointVectorField::typeName, false) : io.objectPath()
+               ).c_str() << "): decompose"
             << " the case's time " << runTime.timeName() << " again, or remove"
             << " " << morphBaseName << " from every rank's " << runTime.timeName()
             << " to morph from the initial mesh" << exit(FatalError);
@@ -107,7 +130,7 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     basePtr_.reset(new morphBase(io, pointMesh::New(mesh())));
     shift_ = base() - points0();
     Info<< type << ": rebased, morphing from the mesh in "
-        << runTime.relativePath(io.objectPath()).c_str() << endl;
+        << runTime.relativePath(io.localFilePath(pointVectorField::typeName, false)).c_str() << endl;
 }
 
 
