@@ -93,18 +93,7 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     {
         // (a run that rebased writes its base at every later write time: on
         // a mesh that has moved since the initial one, say what is morphed)
-        bool moved = false;
-        const pointField& p = mesh().points();
-        const pointField& p0 = points0();
-        forAll(p, pointi)
-        {
-            if (p[pointi] != p0[pointi])
-            {
-                moved = true;
-                break;
-            }
-        }
-        if (returnReduce(moved, orOp<bool>()))
+        if (!atPoints(points0()))
         {
             Info<< type << ": rebase on, no " << morphBaseName << " in "
                 << runTime.timeName() << ": morphing from the initial mesh"
@@ -113,16 +102,17 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
         }
         return;
     }
+    // (the file the handler reads: processorsN/<time>/morphBase collated)
+    const fileName readFrom =
+        found ? io.localFilePath(pointVectorField::typeName, false) : fileName();
     if (!returnReduce(found, andOp<bool>()))
     {
         FatalErrorInFunction
             << "rebase on: the morph's base " << morphBaseName << " is in "
             << runTime.timeName() << " of some ranks' directories only ("
             << (found ? "found" : "not found") << " in "
-            << runTime.relativePath
-               (
-                   found ? io.localFilePath(pointVectorField::typeName, false) : io.objectPath()
-               ).c_str() << "): decompose"
+            << runTime.relativePath(found ? readFrom : io.objectPath()).c_str()
+            << "): decompose"
             << " the case's time " << runTime.timeName() << " again, or remove"
             << " " << morphBaseName << " from every rank's " << runTime.timeName()
             << " to morph from the initial mesh" << exit(FatalError);
@@ -130,7 +120,7 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     basePtr_.reset(new morphBase(io, pointMesh::New(mesh())));
     shift_ = base() - points0();
     Info<< type << ": rebased, morphing from the mesh in "
-        << runTime.relativePath(io.localFilePath(pointVectorField::typeName, false)).c_str() << endl;
+        << runTime.relativePath(readFrom).c_str() << endl;
 }
 
 
@@ -147,6 +137,22 @@ Foam::tmp<Foam::scalarField> Foam::interpolatingMotionSolver::cellVolumesOf
         V[celli] = invertedCellCheck::checkMeshVolume(mesh(), points, celli, centre);
     }
     return tV;
+}
+
+
+bool Foam::interpolatingMotionSolver::atPoints(const pointField& b) const
+{
+    const pointField& p = mesh().points();
+    bool same = true;
+    forAll(p, pointi)
+    {
+        if (p[pointi] != b[pointi])
+        {
+            same = false;
+            break;
+        }
+    }
+    return returnReduce(same, andOp<bool>());
 }
 
 
@@ -188,17 +194,11 @@ bool Foam::interpolatingMotionSolver::rebase(const string& why)
 {
     // (nothing to gain where the mesh is the base already: the first step,
     // or a step morphed again)
-    const pointField& p = mesh().points();
-    const pointField& b = base();
-    scalar moved = 0;
-    forAll(p, pointi)
-    {
-        moved = max(moved, magSqr(p[pointi] - b[pointi]));
-    }
-    if (returnReduce(moved, maxOp<scalar>()) == 0)
+    if (atPoints(base()))
     {
         return false;
     }
+    const pointField& p = mesh().points();
     const Time& runTime = mesh().time();
     Info<< type() << ": " << why.c_str() << " (rebase on), at time "
         << runTime.timeName()
