@@ -354,9 +354,15 @@ int main(int argc, char *argv[])
         wallPatches = patches.patchSet(names).sortedToc();
         if (returnReduce(wallPatches.empty(), andOp<bool>()))
         {
+            // (the case's patches: every rank's, without its processor patches)
+            wordList caseNames(patches.nNonProcessor());
+            forAll(caseNames, patchi)
+            {
+                caseNames[patchi] = patches[patchi].name();
+            }
             FatalErrorInFunction
                 << "-patches " << flatOutput(names) << " matches no patch; patches are "
-                << flatOutput(patches.names()) << exit(FatalError);
+                << flatOutput(caseNames) << exit(FatalError);
         }
     }
     else
