@@ -22,6 +22,8 @@ License
 #include "Enum.H"
 #include "clockTime.H"
 
+#include <utility>
+
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
 namespace Foam
@@ -189,6 +191,22 @@ void Foam::RBFMotionSolver::readCoeffs()
         "function", "shapeParameter", "supportRadius", "polynomial",
         "maxPoints", "greedyTolerance", "greedyBatch"
     });
+    // (each parameter belongs to one function: given to another, a warning)
+    const std::pair<word, rbf::kernel> owners[] =
+    {
+        {"shapeParameter", rbf::kernel::inverseMultiquadric},
+        {"supportRadius", rbf::kernel::wendlandC2}
+    };
+    for (const auto& own : owners)
+    {
+        if (own.second != params_.function && dict.found(own.first))
+        {
+            IOWarningInFunction(dict)
+                << own.first << " is read with function "
+                << kernelNames[own.second] << " only, here "
+                << kernelNames[params_.function] << ": ignored" << endl;
+        }
+    }
     if (params_.function == rbf::kernel::thinPlateSpline && !params_.polynomial)
     {
         FatalIOErrorInFunction(dict)
