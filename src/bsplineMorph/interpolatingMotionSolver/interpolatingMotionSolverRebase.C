@@ -102,17 +102,17 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
         }
         return;
     }
-    // (the file the handler reads: processorsN/<time>/morphBase collated)
+    // (the file the handler reads, processorsN/<time>/morphBase collated;
+    // where there is none, the one this rank would read)
     const fileName readFrom =
-        found ? io.localFilePath(pointVectorField::typeName, false) : fileName();
+        found ? io.localFilePath(pointVectorField::typeName, false) : io.objectPath();
     if (!returnReduce(found, andOp<bool>()))
     {
         FatalErrorInFunction
             << "rebase on: the morph's base " << morphBaseName << " is in "
             << runTime.timeName() << " of some ranks' directories only ("
             << (found ? "found" : "not found") << " in "
-            << runTime.relativePath(found ? readFrom : io.objectPath()).c_str()
-            << "): decompose"
+            << runTime.relativePath(readFrom).c_str() << "): decompose"
             << " the case's time " << runTime.timeName() << " again, or remove"
             << " " << morphBaseName << " from every rank's " << runTime.timeName()
             << " to morph from the initial mesh" << exit(FatalError);
