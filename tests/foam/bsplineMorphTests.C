@@ -410,7 +410,7 @@ TEST_CASE("multilevelBSpline: invalid keyword values name the entry", "[foam][bs
     CHECK_THAT(errorOf(tps + "{ grid 0; }"), Contains("'grid' is 0") && Contains("from 1 to 32") && Contains("default 8"));
     CHECK_THAT(errorOf(tps + "{ level 6; }"), Contains("'level' is 6") && Contains("from 0 to 5") && Contains("default 4"));
     CHECK(errorOf(tps + "{ grid 6; level 3; }") == "no error");
-    CHECK_THAT(errorOf(tps + "3;"), Contains("thinPlateSplineCoeffs must be a dictionary"));
+    CHECK_THAT(errorOf(tps + "3;"), Contains("thinPlateSplineCoeffs must be a dictionary { grid ...; level ...; }"));
     const std::string inverted = errorOf("invertedCells maybe;");
     CHECK_THAT(inverted, Contains("'invertedCells' is 'maybe'") && Contains("fatal") && Contains("warn")
         && Contains("default fatal"));
@@ -513,7 +513,7 @@ TEST_CASE("rigidLayers: bad input names the entry and the valid choices", "[foam
         errorOf("rigidLayers { patches (walls); innerDistance 0.1; }", "RBF"),
         Contains("outerDistance")
     );
-    CHECK_THAT(errorOf("rigidLayers (walls);"), Contains("rigidLayers"));
+    CHECK_THAT(errorOf("rigidLayers (walls);"), Contains("rigidLayers must be a dictionary { patches (...);"));
     CHECK(errorOf("rigidLayers { patches (\"w.*\"); innerDistance 0; outerDistance 0.2; }") == "no error");
 }
 

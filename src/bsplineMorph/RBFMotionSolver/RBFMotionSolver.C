@@ -199,13 +199,11 @@ void Foam::RBFMotionSolver::readCoeffs()
     };
     for (const auto& own : owners)
     {
-        if (own.second != params_.function && dict.found(own.first))
-        {
-            IOWarningInFunction(dict)
-                << own.first << " is read with function "
-                << kernelNames[own.second] << " only, here "
-                << kernelNames[params_.function] << ": ignored" << endl;
-        }
+        coeffsInput::warnUnread
+        (
+            dict, own.first, "function", kernelNames[own.second],
+            kernelNames[params_.function]
+        );
     }
     if (params_.function == rbf::kernel::thinPlateSpline && !params_.polynomial)
     {

@@ -109,4 +109,38 @@ void Foam::coeffsInput::warnUnknown
 }
 
 
+void Foam::coeffsInput::checkDict
+(
+    const dictionary& dict,
+    const word& key,
+    const string& entries
+)
+{
+    if (dict.found(key) && !dict.isDict(key))
+    {
+        FatalIOErrorInFunction(dict)
+            << key << " must be a dictionary { " << entries.c_str() << " }"
+            << exit(FatalIOError);
+    }
+}
+
+
+void Foam::coeffsInput::warnUnread
+(
+    const dictionary& dict,
+    const word& key,
+    const word& entry,
+    const word& readWith,
+    const word& here
+)
+{
+    if (readWith != here && dict.found(key))
+    {
+        IOWarningInFunction(dict)
+            << key << " is read with " << entry << ' ' << readWith
+            << " only, here " << here << ": ignored" << endl;
+    }
+}
+
+
 // ************************************************************************* //

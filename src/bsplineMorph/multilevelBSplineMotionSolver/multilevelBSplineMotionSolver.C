@@ -334,12 +334,7 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
     // affine start then fits what the sampled spline leaves)
     params_.affine = start != initialApproximation::none;
     trendGrid_ = 0;
-    if (dict.found("thinPlateSplineCoeffs") && !dict.isDict("thinPlateSplineCoeffs"))
-    {
-        FatalIOErrorInFunction(dict)
-            << "thinPlateSplineCoeffs must be a dictionary { grid ...; level"
-            << " ...; }" << exit(FatalIOError);
-    }
+    coeffsInput::checkDict(dict, "thinPlateSplineCoeffs", "grid ...; level ...;");
     if (start == initialApproximation::thinPlateSpline)
     {
         // (its entries only: none falls back to the enclosing dictionary)
@@ -348,13 +343,12 @@ void Foam::multilevelBSplineMotionSolver::readCoeffs()
         trendLevel_ = coeffsInput::getInRange<label>(tps, "level", 4, 0, 5);
         coeffsInput::warnUnknown(tps, {"grid", "level"});
     }
-    else if (dict.found("thinPlateSplineCoeffs"))
-    {
-        IOWarningInFunction(dict)
-            << "thinPlateSplineCoeffs is read with initialApproximation"
-            << " thinPlateSpline only, here "
-            << initialApproximationNames[start] << ": ignored" << endl;
-    }
+    coeffsInput::warnUnread
+    (
+        dict, "thinPlateSplineCoeffs", "initialApproximation",
+        initialApproximationNames[initialApproximation::thinPlateSpline],
+        initialApproximationNames[start]
+    );
     params_.bucketTiles = coeffsInput::getInRange<label>(dict, "bucketTiles", 32, 1);
     params_.exchange = coeffsInput::getEnum
     (

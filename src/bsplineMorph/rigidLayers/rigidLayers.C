@@ -157,12 +157,11 @@ Foam::autoPtr<Foam::rigidLayers> Foam::rigidLayers::New
     {
         return nullptr;
     }
-    if (!coeffDict.isDict("rigidLayers"))
-    {
-        FatalIOErrorInFunction(coeffDict)
-            << "rigidLayers must be a dictionary { patches (...); innerDistance"
-            << " ...; outerDistance ...; }" << exit(FatalIOError);
-    }
+    coeffsInput::checkDict
+    (
+        coeffDict, "rigidLayers",
+        "patches (...); innerDistance ...; outerDistance ...;"
+    );
     return autoPtr<rigidLayers>::New(mesh, coeffDict.subDict("rigidLayers"));
 }
 
