@@ -10,8 +10,10 @@
                                              with the hole's rigid motion (fitted to the hole);
                                              --slip-layers: and those within INNER of a sliding
                                              box face (x, y) keep their distance from it
-    checkPoints.py cyclic CASE box|sector    the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
-                                             the box's x faces, the sector's sides) have displacements
+    checkPoints.py cyclic CASE box|sector|pipe
+                                             the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
+                                             the box's x faces, the sector's or the pipe's sides, those
+                                             on the pipe's axis their own partners) have displacements
                                              equal through the pair's transform at every written time
     checkPoints.py tiltedSlip CASE [--planes-only]
                                              the sheared block of tests/foam/Alltest.d/tiltedSlip at
@@ -57,7 +59,9 @@ def cyclicPairs(case, kind):
         T = lambda v: (v[0] + 1.0, v[1], v[2])
         R = lambda v: v
     else:                  # side0 (y = 0) -> side90 (x = 0): turn by 90 deg about z
-        onA = lambda p: abs(p[1]) < 1e-9 and p[0] > 0.5
+        # (the pipe's sides meet on the axis: its points there are their own
+        # partners, whose displacement the turn must leave as it is)
+        onA = lambda p: abs(p[1]) < 1e-9 and p[0] > (0.5 if kind == "sector" else -1e-9)
         T = R = lambda v: (-v[1], v[0], v[2])
     key = lambda p: tuple(round(x, 8) for x in p)
     index = {key(p): i for i, p in enumerate(p0)}

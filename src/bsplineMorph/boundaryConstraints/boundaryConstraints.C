@@ -153,12 +153,49 @@ Foam::boundaryConstraints::boundaryConstraints
     }
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
+    findCyclicAxisPoints(points0);
 
+    readSlipPlanes(pointDisplacement, points0);
     update(pointDisplacement, shift);
 }
 
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::boundaryConstraints::findCyclicAxisPoints(const pointField& points0)
+{
+    const polyMesh& mesh = pMesh_();
+    const scalar onAxis = 1e-9*mesh.bounds().mag();
+    DynamicList<label> points;
+    DynamicList<vector> axes;
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        const cyclicPolyPatch* cyc =
+            isA<processorCyclicPolyPatch>(pp)
+          ? isA<cyclicPolyPatch>
+            (
+                refCast<const processorCyclicPolyPatch>(pp).referPatch()
+            )
+          : isA<processorPolyPatch>(pp) ? nullptr : isA<cyclicPolyPatch>(pp);
+        if (!cyc || cyc->transform() != coupledPolyPatch::ROTATIONAL)
+        {
+            continue;
+        }
+        const vector axis = cyc->rotationAxis()/mag(cyc->rotationAxis());
+        for (const label pointi : pp.meshPoints())
+        {
+            const vector r = points0[pointi] - cyc->rotationCentre();
+            if (mag(r - (r & axis)*axis) <= onAxis)
+            {
+                points.append(pointi);
+                axes.append(axis);
+            }
+        }
+    }
+    cyclicAxisPoints_.transfer(points);
+    cyclicAxes_.transfer(axes);
+}
+
 
 bool Foam::boundaryConstraints::heldComponents
 (

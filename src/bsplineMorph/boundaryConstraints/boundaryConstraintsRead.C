@@ -107,7 +107,9 @@ void Foam::boundaryConstraints::readFixedPatch
     forAll(meshPoints, i)
     {
         const label pointi = meshPoints[i];
-        fixedSync_[pointi] = 1;
+        // (the patches in order: a point of several takes the last one's
+        // value, and its index, with which update() decides on every rank)
+        fixedSync_[pointi] = pp.index() + 1;
         value_[pointi] = values[i];
         for (direction c = 0; c < 3; ++c)
         {
@@ -149,7 +151,7 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
             slide_[pointi].applyConstraint(m);
         }
     };
-    if (pf.type() == "slip" || pp.constraintType() == "symmetry")
+    if (slidesOnFaces(pf))
     {
         // Each face's own normal on each of its points, combined (plane,
         // line, fixed): a patch spanning several planes (the faces of a box)
@@ -161,9 +163,9 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         // slip slides along point normals (leaving a wall of radius R by
         // about d^2/2R for a slide d)
         const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
-        const vectorField& nf = patch.faceNormals();
+        const vectorField& nf = slipNormals_[pp.index()];
         const labelListList& pointFaces = patch.pointFaces();
-        const vectorField mean(curvedSlip(patch));
+        const vectorField& mean = slipMean_[pp.index()];
         forAll(pointFaces, lp)
         {
             if (mean.size() && mean[lp] != vector::zero)
@@ -212,18 +214,47 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
 }
 
 
-Foam::vectorField Foam::boundaryConstraints::curvedSlip(const polyPatch& patch)
+bool Foam::boundaryConstraints::slidesOnFaces(const pointPatchVectorField& pf)
 {
-    const bool first = !slipShared_.found(patch.name());
-    if (!first && !slipShared_[patch.name()])
+    return
+        !pf.patch().coupled() && !pf.fixesValue()
+     && (pf.type() == "slip" || pf.patch().constraintType() == "symmetry");
+}
+
+
+void Foam::boundaryConstraints::readSlipPlanes
+(
+    const pointVectorField& pointDisplacement,
+    const pointField& points0
+)
+{
+    const label nPatches = pointDisplacement.boundaryField().size();
+    slipNormals_.setSize(nPatches);
+    slipMean_.setSize(nPatches);
+    for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
     {
-        return vectorField();
+        if (!slidesOnFaces(pf))
+        {
+            continue;
+        }
+        const polyPatch& patch = refCast<const facePointPatch>(pf.patch()).patch();
+        vectorField& nf = slipNormals_[pf.patch().index()];
+        nf.setSize(patch.size());
+        forAll(patch, facei)
+        {
+            nf[facei] = patch[facei].unitNormal(points0);
+        }
+        slipMean_[pf.patch().index()] = curvedSlip(patch, nf);
     }
-    std::shared_ptr<const sharedPoints> shared =
-        first
-      ? std::make_shared<const sharedPoints>(pMesh_(), patch.meshPoints())
-      : slipShared_[patch.name()];
-    const vectorField& nf = patch.faceNormals();
+}
+
+
+Foam::vectorField Foam::boundaryConstraints::curvedSlip
+(
+    const polyPatch& patch,
+    const vectorField& nf
+) const
+{
     const labelListList& pointFaces = patch.pointFaces();
     List<vector> sum(patch.nPoints(), Zero);
     List<scalar> count(patch.nPoints(), Zero);
@@ -235,8 +266,9 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip(const polyPatch& patch)
             count[lp] += 1;
         }
     }
-    shared->sum(sum);
-    shared->sum(count);
+    const sharedPoints shared(pMesh_(), patch.meshPoints());
+    shared.sum(sum);
+    shared.sum(count);
     // Bent smoothly: |sum| of unit normals within (cos curvedSlipAngle, 1)
     // of their count (two faces: within twice the angle of each other;
     // coplanar ones to rounding, 1e-9, keep their own normals)
@@ -252,12 +284,8 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip(const polyPatch& patch)
             bent = true;
         }
     }
-    if (first)
-    {
-        reduce(bent, orOp<bool>());
-        slipShared_.insert(patch.name(), bent ? shared : nullptr);
-    }
-    return mean;
+    reduce(bent, orOp<bool>());
+    return bent ? mean : vectorField();
 }
 
 
@@ -366,10 +394,30 @@ void Foam::boundaryConstraints::update
             slide_[pointi].combine(alongAxis);
         }
     }
+    // and those on a rotational cyclic pair's axis, each its own partner,
+    // along that axis
+    forAll(cyclicAxisPoints_, i)
+    {
+        slide_[cyclicAxisPoints_[i]].combine
+        (
+            pointConstraint(Tuple2<label, vector>(2, cyclicAxes_[i]))
+        );
+    }
 
     // The same view of every processor-shared point on all its ranks (the
-    // conditions set values at their patches' points only)
+    // conditions set values at their patches' points only). A point of
+    // several fixed patches takes the last one's value (in the patches'
+    // order, as when one rank holds them all) whichever ranks hold which;
+    // so do a cyclic pair's points, through its transform
+    const labelList mine(UIndirectList<label>(fixedSync_, boundaryPoints_));
     conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
+    forAll(boundaryPoints_, i)
+    {
+        if (mine[i] != fixedSync_[boundaryPoints_[i]])
+        {
+            value_[boundaryPoints_[i]] = Zero;
+        }
+    }
     conditionPoints_->combineMesh(value_, maxMagSqrEqOp<vector>(), vector::zero);
     conditionPoints_->combineMesh(slide_, combineConstraintsEqOp(), pointConstraint());
 

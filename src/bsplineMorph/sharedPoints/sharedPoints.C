@@ -36,11 +36,9 @@ Foam::sharedPoints::sharedPoints
     toOwner_(Pstream::nProcs()),
     fromHolder_(Pstream::nProcs())
 {
-    if (!Pstream::parRun())
-    {
-        return;
-    }
-    // Copies related by a transform (mergePoints joins collocated ones only)
+    // Copies related by a transform (mergePoints joins collocated ones
+    // only), on one rank too: a cyclic pair's points combine as they do
+    // when the pair is split over ranks
     for (const polyPatch& pp : mesh.boundaryMesh())
     {
         if
@@ -53,7 +51,7 @@ Foam::sharedPoints::sharedPoints
         }
     }
     reduce(general_, orOp<bool>());
-    if (general_)
+    if (general_ || !Pstream::parRun())
     {
         return;
     }
