@@ -63,6 +63,60 @@ double now()
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+/// Add to centres (marking them in used) the points of x that the linear
+/// polynomial needs: while the centres span fewer than D dimensions (their
+/// offsets from the first, orthonormalised), the point farthest from their
+/// span (the lowest index of equals; none beyond tol of it: the points
+/// themselves span no more)
+template <int D>
+void spanPolynomial(const std::vector<point<D>>& x, double tol, std::vector<std::size_t>& centres,
+                    std::vector<char>& used)
+{
+    std::vector<std::array<double, D>> basis;
+    // r's part off the span of basis (r itself: its offset from the first centre)
+    const auto offSpan = [&](std::array<double, D> r) {
+        for (const auto& e : basis)
+        {
+            double dot = 0;
+            for (int d = 0; d < D; ++d) dot += r[d]*e[d];
+            for (int d = 0; d < D; ++d) r[d] -= dot*e[d];
+        }
+        return r;
+    };
+    const auto offset = [&](std::size_t i) {
+        std::array<double, D> r;
+        for (int d = 0; d < D; ++d) r[d] = x[i][d] - x[centres[0]][d];
+        return r;
+    };
+    const auto grow = [&](const std::array<double, D>& r) {
+        double m = 0;
+        for (int d = 0; d < D; ++d) m += r[d]*r[d];
+        m = std::sqrt(m);
+        if (m <= tol) return false;
+        std::array<double, D> e;
+        for (int d = 0; d < D; ++d) e[d] = r[d]/m;
+        basis.push_back(e);
+        return true;
+    };
+    for (std::size_t k = 1; k < centres.size() && int(basis.size()) < D; ++k) grow(offSpan(offset(centres[k])));
+    while (int(basis.size()) < D)
+    {
+        std::size_t best = x.size();
+        double far = -1;
+        for (std::size_t i = 0; i < x.size(); ++i)
+        {
+            if (used[i]) continue;
+            const auto r = offSpan(offset(i));
+            double m = 0;
+            for (int d = 0; d < D; ++d) m += r[d]*r[d];
+            if (m > far) { far = m; best = i; }
+        }
+        if (best == x.size() || !grow(offSpan(offset(best)))) return;
+        centres.push_back(best);
+        used[best] = 1;
+    }
+}
+
 } // namespace
 
 template <int D>
@@ -173,7 +227,8 @@ void interpolant<D>::factor(const std::vector<std::size_t>& centres)
         precondition(m <= p_.maxPoints,
             "rbf: " + std::to_string(m) + " control points exceed maxPoints " + std::to_string(p_.maxPoints)
             + "; the dense system would need " + std::to_string(double(n)*n*8/1048576.0) + " MB per rank"
-            + " (raise maxPoints if the memory is there, or use greedy selection)");
+            + " (raise maxPoints if the memory is there, or "
+            + (p_.greedyTolerance > 0 ? "greedyTolerance, or lower greedyBatch)" : "use greedy selection: greedyTolerance)"));
     });
     centres_ = centres;
     stats_.centres = m;
@@ -292,6 +347,9 @@ void interpolant<D>::fit(const std::vector<double>& values)
         std::vector<std::size_t> centres;
         const std::size_t step = std::max<std::size_t>(1, x_.size()/std::size_t(p_.greedyBatch));
         for (std::size_t i = 0; i < x_.size(); i += step) { centres.push_back(i); used[i] = 1; }
+        // (a small batch, or one in a plane, would leave the polynomial's
+        // coefficients undetermined: a singular first system)
+        if (p_.polynomial) spanPolynomial<D>(x_, 1e-9*scale_, centres, used);
         std::vector<double> err(x_.size()), s(nc_);
         for (;;)
         {
@@ -312,6 +370,14 @@ void interpolant<D>::fit(const std::vector<double>& values)
             std::vector<std::size_t> cand(x_.size());
             std::iota(cand.begin(), cand.end(), 0);
             const std::size_t add = std::min<std::size_t>(std::size_t(p_.greedyBatch), x_.size() - centres.size());
+            mba::collectively(comm_, [&] {
+                std::ostringstream os;
+                os << "rbf: the greedy selection needs more than maxPoints " << p_.maxPoints
+                   << " centres: with " << centres.size() << " the largest error at the control points is still "
+                   << stats_.maxError << " of the largest value, above greedyTolerance " << p_.greedyTolerance
+                   << " (raise maxPoints if the memory is there, or greedyTolerance)";
+                precondition(long(centres.size() + add) <= p_.maxPoints, os.str());
+            });
             std::partial_sort(cand.begin(), cand.begin() + add, cand.end(),
                               [&](std::size_t a, std::size_t b) { return err[a] > err[b] || (err[a] == err[b] && a < b); });
             for (std::size_t k = 0; k < add; ++k) { centres.push_back(cand[k]); used[cand[k]] = 1; }

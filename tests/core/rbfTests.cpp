@@ -131,6 +131,26 @@ TEST_CASE("RBF greedy selection meets its tolerance with fewer centres", "[rbf]"
     for (std::size_t i = 0; i < v.size(); ++i) REQUIRE(std::abs(out[i] - v[i]) <= 1e-3*vmax*(1 + 1e-9));
 }
 
+TEST_CASE("RBF greedy selection from one centre a step spans the polynomial first", "[rbf]")
+{
+    // (its first batch alone, one point, or several on one face of the
+    // cube, would leave the linear polynomial undetermined: singular)
+    const auto c = surfacePoints<3>(8);
+    std::vector<double> v;
+    for (const auto& x : c) v.push_back(0.1*std::sin(3*x[0])*std::cos(2*x[1]) + 0.05*x[2]);
+    for (int batch : {1, 2, 4})
+    {
+        rbf::params p;
+        p.greedyTolerance = 1e-2;
+        p.greedyBatch = batch;
+        rbf::interpolant<3> s(mba::serial(), p, 1, c);
+        s.fit(v);
+        INFO("greedyBatch " << batch << ": " << s.stats().centres << " centres");
+        CHECK(s.stats().centres < s.stats().controlPoints);
+        CHECK(s.stats().maxError <= 1e-2);
+    }
+}
+
 TEST_CASE("RBF rejects bad parameters and systems with a clear message", "[rbf][errors]")
 {
     const auto c = randomPoints<3>(100, 231);
@@ -147,6 +167,17 @@ TEST_CASE("RBF rejects bad parameters and systems with a clear message", "[rbf][
     {
         p.maxPoints = 50;
         REQUIRE_THROWS_WITH((rbf::interpolant<3>(mba::serial(), p, 1, c)), Contains("100 control points exceed maxPoints 50") && Contains("MB"));
+    }
+    SECTION("greedy selection beyond maxPoints")
+    {
+        p.maxPoints = 20;
+        p.greedyTolerance = 1e-6;
+        p.greedyBatch = 8;
+        std::vector<double> v;
+        for (const auto& x : c) v.push_back(std::sin(5*x[0])*std::cos(4*x[1]) + x[2]*x[2]);
+        rbf::interpolant<3> s(mba::serial(), p, 1, c);
+        REQUIRE_THROWS_WITH(s.fit(v), Contains("the greedy selection needs more than maxPoints 20 centres")
+            && Contains("greedyTolerance 1e-06") && !Contains("use greedy selection"));
     }
     SECTION("ill-conditioned")
     {
