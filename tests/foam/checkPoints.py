@@ -10,7 +10,7 @@
                                              with the hole's rigid motion (fitted to the hole);
                                              --slip-layers: and those within INNER of a sliding
                                              box face (x, y) keep their distance from it
-    checkPoints.py cyclic CASE box|sector|pipe
+    checkPoints.py cyclic CASE box|sector|pipe|layers
                                              the points of a cyclic pair (tests/foam/Alltest.d/cyclic:
                                              the box's x faces, the sector's or the pipe's sides, those
                                              on the pipe's axis their own partners) have displacements
@@ -54,7 +54,7 @@ def check(cond, msg):
 
 def cyclicPairs(case, kind):
     p0 = pointsAt(case, "constant")
-    if kind == "box":      # left (x = 0) -> right (x = 1): translate by (1 0 0)
+    if kind in ("box", "layers"):   # left (x = 0) -> right (x = 1): translate by (1 0 0)
         onA = lambda p: abs(p[0]) < 1e-9
         T = lambda v: (v[0] + 1.0, v[1], v[2])
         R = lambda v: v

@@ -104,12 +104,13 @@ Foam::boundaryConstraints::boundaryConstraints
 (
     const pointVectorField& pointDisplacement,
     const pointField& points0,
+    const pointField& base,
     const scalar curvedSlipAngle,
     const vectorField* shift
 )
 :
     pMesh_(pointDisplacement.mesh()),
-    frame_(std::make_shared<const solutionFrame>(pMesh_(), points0)),
+    frame_(std::make_shared<const solutionFrame>(pMesh_(), base)),
     nCyclicGlobal_(0),
     curvedSlipCos_(std::cos(degToRad(curvedSlipAngle)))
 {
@@ -153,9 +154,9 @@ Foam::boundaryConstraints::boundaryConstraints
     }
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
-    findCyclicAxisPoints(points0);
+    findCyclicAxisPoints(base);
 
-    readSlipPlanes(pointDisplacement, points0);
+    readSlipPlanes(pointDisplacement, points0, base);
     update(pointDisplacement, shift);
 }
 
@@ -341,8 +342,11 @@ void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
         return;
     }
     // Sums and counts over each set of joined points (syncPointList adds
-    // them, each transformed to the receiving point's side); fixed points
-    // keep their prescribed values (the same on every copy)
+    // them, each transformed to the receiving point's side), of the free
+    // points and of the fixed ones: fixed points keep their values, and
+    // where a set has some, its free points take their mean (a rigid
+    // zone's outermost point on one side of a pair, fixed at the zone's
+    // motion, carries its partner along), else the free points' mean
     const polyMesh& mesh = pMesh_();
     if (cyclicSum_.size() != mesh.nPoints())
     {
@@ -350,20 +354,35 @@ void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
         // combines every coupled point)
         cyclicSum_.setSize(mesh.nPoints(), Zero);
         cyclicCount_.setSize(mesh.nPoints(), 0);
+        cyclicFixedSum_.setSize(mesh.nPoints(), Zero);
+        cyclicFixedCount_.setSize(mesh.nPoints(), 0);
     }
     // (each point counted once: on the rank that owns it, not on those
     // that hold a copy of it through a processor patch)
     for (const label pointi : cyclicPoints_)
     {
-        const bool counted = !fixed_[pointi] && owned_[pointi];
-        cyclicSum_[pointi] = counted ? displacement[pointi] : Zero;
-        cyclicCount_[pointi] = counted;
+        const bool counted = owned_[pointi];
+        const bool free = !fixed_[pointi];
+        cyclicSum_[pointi] = counted && free ? displacement[pointi] : Zero;
+        cyclicCount_[pointi] = counted && free;
+        cyclicFixedSum_[pointi] = counted && !free ? value_[pointi] : Zero;
+        cyclicFixedCount_[pointi] = counted && !free;
     }
     syncTools::syncPointList(mesh, cyclicSum_, plusEqOp<vector>(), vector::zero);
     syncTools::syncPointList(mesh, cyclicCount_, plusEqOp<scalar>(), scalar(0));
+    syncTools::syncPointList(mesh, cyclicFixedSum_, plusEqOp<vector>(), vector::zero);
+    syncTools::syncPointList(mesh, cyclicFixedCount_, plusEqOp<scalar>(), scalar(0));
     for (const label pointi : cyclicPoints_)
     {
-        if (!fixed_[pointi] && cyclicCount_[pointi] > 0)
+        if (fixed_[pointi])
+        {
+            continue;
+        }
+        if (cyclicFixedCount_[pointi] > 0)
+        {
+            displacement[pointi] = cyclicFixedSum_[pointi]/cyclicFixedCount_[pointi];
+        }
+        else if (cyclicCount_[pointi] > 0)
         {
             displacement[pointi] = cyclicSum_[pointi]/cyclicCount_[pointi];
         }

@@ -225,7 +225,8 @@ bool Foam::boundaryConstraints::slidesOnFaces(const pointPatchVectorField& pf)
 void Foam::boundaryConstraints::readSlipPlanes
 (
     const pointVectorField& pointDisplacement,
-    const pointField& points0
+    const pointField& points0,
+    const pointField& base
 )
 {
     const label nPatches = pointDisplacement.boundaryField().size();
@@ -238,26 +239,37 @@ void Foam::boundaryConstraints::readSlipPlanes
             continue;
         }
         const polyPatch& patch = refCast<const facePointPatch>(pf.patch()).patch();
-        vectorField& nf = slipNormals_[pf.patch().index()];
-        nf.setSize(patch.size());
-        forAll(patch, facei)
+        const auto unitNormals = [&patch](const pointField& points)
         {
-            nf[facei] = patch[facei].unitNormal(points0);
-        }
-        slipMean_[pf.patch().index()] = curvedSlip(patch, nf);
+            vectorField nf(patch.size());
+            forAll(patch, facei)
+            {
+                nf[facei] = patch[facei].unitNormal(points);
+            }
+            return nf;
+        };
+        vectorField& nf0 = slipNormals_[pf.patch().index()];
+        nf0 = unitNormals(points0);
+        // (a rebased morph's curved walls slide in the planes at its base)
+        slipMean_[pf.patch().index()] =
+            &base == &points0
+          ? curvedSlip(patch, nf0, nf0)
+          : curvedSlip(patch, nf0, unitNormals(base));
     }
 }
 
 
-Foam::vectorField Foam::boundaryConstraints::curvedSlip
+void Foam::boundaryConstraints::sumFaceNormals
 (
     const polyPatch& patch,
-    const vectorField& nf
+    const vectorField& nf,
+    List<vector>& sum,
+    List<scalar>& count
 ) const
 {
     const labelListList& pointFaces = patch.pointFaces();
-    List<vector> sum(patch.nPoints(), Zero);
-    List<scalar> count(patch.nPoints(), Zero);
+    sum = List<vector>(patch.nPoints(), Zero);
+    count = List<scalar>(patch.nPoints(), Zero);
     forAll(pointFaces, lp)
     {
         for (const label facei : pointFaces[lp])
@@ -269,23 +281,49 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip
     const sharedPoints shared(pMesh_(), patch.meshPoints());
     shared.sum(sum);
     shared.sum(count);
+}
+
+
+Foam::vectorField Foam::boundaryConstraints::curvedSlip
+(
+    const polyPatch& patch,
+    const vectorField& nf0,
+    const vectorField& nf
+) const
+{
+    List<vector> sum;
+    List<scalar> count;
+    sumFaceNormals(patch, nf0, sum, count);
     // Bent smoothly: |sum| of unit normals within (cos curvedSlipAngle, 1)
     // of their count (two faces: within twice the angle of each other;
     // coplanar ones to rounding, 1e-9, keep their own normals)
     const scalar smooth = curvedSlipCos_;
-    vectorField mean(patch.nPoints(), Zero);
+    boolList bentAt(patch.nPoints(), false);
     bool bent = false;
     forAll(sum, lp)
     {
         const scalar m = mag(sum[lp]);
-        if (m >= smooth*count[lp] && m < (1 - 1e-9)*count[lp])
-        {
-            mean[lp] = sum[lp]/m;
-            bent = true;
-        }
+        bentAt[lp] = m >= smooth*count[lp] && m < (1 - 1e-9)*count[lp];
+        bent = bent || bentAt[lp];
     }
     reduce(bent, orOp<bool>());
-    return bent ? mean : vectorField();
+    if (!bent)
+    {
+        return vectorField();
+    }
+    if (&nf != &nf0)
+    {
+        sumFaceNormals(patch, nf, sum, count);
+    }
+    vectorField mean(patch.nPoints(), Zero);
+    forAll(sum, lp)
+    {
+        if (bentAt[lp])
+        {
+            mean[lp] = sum[lp]/mag(sum[lp]);
+        }
+    }
+    return mean;
 }
 
 

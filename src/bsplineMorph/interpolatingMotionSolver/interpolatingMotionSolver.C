@@ -375,7 +375,7 @@ bool Foam::interpolatingMotionSolver::updateControls()
         (
             new boundaryConstraints
             (
-                pointDisplacement_, base(), curvedSlipAngle_, shift()
+                pointDisplacement_, points0(), base(), curvedSlipAngle_, shift()
             )
         );
     }

@@ -448,9 +448,20 @@ void Foam::rigidLayers::plan(const pointField& points0)
     bitSet inner(mesh_.nPoints());
     markRigid(inner);
     const label sweeps = nSweeps(nSmooth_, smoothCoeffs_);
+    // (a wall point where a processor boundary meets the wall may be owned
+    // by a rank whose faces there are not the wall's)
+    labelList onWall(mesh_.nPoints(), 0);
+    UIndirectList<label>(onWall, wallPoints_) = 1;
+    syncTools::syncPointList(mesh_, onWall, maxEqOp<label>(), label(0));
+    label nWall = 0;
+    forAll(onWall, pointi)
+    {
+        nWall += onWall[pointi] && owned[pointi];
+    }
+    reduce(nWall, sumOp<label>());
     Info<< "rigidLayers: " << nOwnedGlobal(owned, zonePoints_)
         << " points within outerDistance " << outerDistance_ << " of "
-        << nOwnedGlobal(owned, wallPoints_) << " wall points on patches "
+        << nWall << " wall points on patches "
         << flatOutput(patchNames)
         << " (" << nOwnedGlobal(owned, inner.toc())
         << " within innerDistance " << innerDistance_ << ", "
