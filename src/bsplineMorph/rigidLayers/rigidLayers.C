@@ -484,63 +484,6 @@ void Foam::rigidLayers::checkConstrained(const boundaryConstraints& bc) const
 }
 
 
-void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
-{
-    // Each point's patch: -1 on a listed one, else the first wall that
-    // holds it on any rank (labelMax: none)
-    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
-    labelList patchOf(mesh_.nPoints(), labelMax);
-    forAllReverse(pbm, patchi)
-    {
-        if (isWall(pbm[patchi]))
-        {
-            const label k = patchIDs_.found(patchi) ? -1 : patchi;
-            for (const label pointi : pbm[patchi].meshPoints())
-            {
-                patchOf[pointi] = min(patchOf[pointi], k);
-            }
-        }
-    }
-    syncTools::syncPointList(mesh_, patchOf, minEqOp<label>(), labelMax);
-
-    const boolList owned(ownedPoints(mesh_));
-    wordHashSet names;
-    label n = 0;
-    scalar nearest = GREAT;
-    forAll(zonePoints_, i)
-    {
-        const label pointi = zonePoints_[i];
-        const label patchi = patchOf[pointi];
-        if
-        (
-            zoneWeight_[i] == 1 && patchi >= 0 && patchi != labelMax
-         && bc.fixed()[pointi]
-        )
-        {
-            names.insert(pbm[patchi].name());
-            nearest = min(nearest, mag(zoneArm_[i]));
-            n += owned[pointi];
-        }
-    }
-    reduce(n, sumOp<label>());
-    reduce(nearest, minOp<scalar>());
-    Pstream::combineGather(names, HashSetOps::plusEqOp<word>());
-    Pstream::combineScatter(names);
-    if (n)
-    {
-        IOWarningInFunction(dict_)
-            << n << " points of " << flatOutput(names.sortedToc())
-            << ", whose boundary conditions fix their displacement, lie"
-            << " within innerDistance " << innerDistance_ << " of the walls"
-            << " (the nearest " << nearest << " from them): they keep that"
-            << " displacement while the points about them move rigidly with"
-            << " the walls, which shears the cells between. List those"
-            << " patches too, or make innerDistance less than " << nearest
-            << endl;
-    }
-}
-
-
 Foam::vector Foam::rigidLayers::rigidMotion
 (
     const label j,

@@ -26,13 +26,14 @@ License
 #include "indexedOctree.H"
 #include "treeDataPoint.H"
 #include "hugePageLists.H"
+#include "HashOps.H"
 
 #include <algorithm>
 #include <vector>
 
 // The plan of the rigid layers, once per topology: the walls' points, each
 // zone point's foot (the nearest wall point, also on nearby ranks), the
-// zone's outermost points
+// zone's outermost points, and the warning about fixed walls in the zone
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
 
@@ -473,6 +474,63 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << " smoothed over " << nSmooth_
         << (nSmooth_ == 1 ? " ring" : " rings") << " of faces, in " << sweeps
         << (sweeps == 1 ? " sweep)" : " sweeps)") << endl;
+}
+
+
+void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
+{
+    // Each point's patch: -1 on a listed one, else the first wall that
+    // holds it on any rank (labelMax: none)
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    labelList patchOf(mesh_.nPoints(), labelMax);
+    forAllReverse(pbm, patchi)
+    {
+        if (isWall(pbm[patchi]))
+        {
+            const label k = patchIDs_.found(patchi) ? -1 : patchi;
+            for (const label pointi : pbm[patchi].meshPoints())
+            {
+                patchOf[pointi] = min(patchOf[pointi], k);
+            }
+        }
+    }
+    syncTools::syncPointList(mesh_, patchOf, minEqOp<label>(), labelMax);
+
+    const boolList owned(ownedPoints(mesh_));
+    wordHashSet names;
+    label n = 0;
+    scalar nearest = GREAT;
+    forAll(zonePoints_, i)
+    {
+        const label pointi = zonePoints_[i];
+        const label patchi = patchOf[pointi];
+        if
+        (
+            zoneWeight_[i] == 1 && patchi >= 0 && patchi != labelMax
+         && bc.fixed()[pointi]
+        )
+        {
+            names.insert(pbm[patchi].name());
+            nearest = min(nearest, mag(zoneArm_[i]));
+            n += owned[pointi];
+        }
+    }
+    reduce(n, sumOp<label>());
+    reduce(nearest, minOp<scalar>());
+    Pstream::combineGather(names, HashSetOps::plusEqOp<word>());
+    Pstream::combineScatter(names);
+    if (n)
+    {
+        IOWarningInFunction(dict_)
+            << n << " points of " << flatOutput(names.sortedToc())
+            << ", whose boundary conditions fix their displacement, lie"
+            << " within innerDistance " << innerDistance_ << " of the walls"
+            << " (the nearest " << nearest << " from them): they keep that"
+            << " displacement while the points about them move rigidly with"
+            << " the walls, which shears the cells between. List those"
+            << " patches too, or make innerDistance less than " << nearest
+            << endl;
+    }
 }
 
 
