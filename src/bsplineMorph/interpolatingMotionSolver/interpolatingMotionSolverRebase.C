@@ -119,6 +119,29 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
     }
     basePtr_.reset(new morphBase(io, pointMesh::New(mesh())));
     shift_ = base() - points0();
+    // A base other than the initial mesh comes from a run that moved the
+    // mesh and wrote its points at every write time: points read from an
+    // earlier time (decomposePar -time '0,T' decomposes the initial mesh
+    // with T's fields) would have the run go on from the wrong mesh
+    const fileName& pointsFrom = mesh().pointsInstance();
+    if
+    (
+        returnReduce(pointsFrom != runTime.timeName(), orOp<bool>())
+     && !returnReduce(base() == points0(), andOp<bool>())
+    )
+    {
+        FatalErrorInFunction
+            << "rebase on: " << runTime.relativePath(readFrom).c_str()
+            << " is the base of a morph that moved the mesh, but the mesh read"
+            << " at time " << runTime.timeName() << " is that of "
+            << pointsFrom.c_str() << " (no polyMesh/points in " << runTime.timeName()
+            << "): the run would go on from the wrong mesh. Give "
+            << runTime.timeName() << " its moved points (decomposePar"
+            << " -latestTime, or -time " << runTime.timeName() << " alone,"
+            << " decomposes that time's mesh), or remove " << morphBaseName
+            << " from " << runTime.timeName() << " to morph from the initial"
+            << " mesh" << exit(FatalError);
+    }
     Info<< type << ": rebased, morphing from the mesh in "
         << runTime.relativePath(readFrom).c_str() << endl;
 }
