@@ -163,7 +163,7 @@ Foam::boundaryConstraints::boundaryConstraints
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-void Foam::boundaryConstraints::findCyclicAxisPoints(const pointField& points0)
+void Foam::boundaryConstraints::findCyclicAxisPoints(const pointField& base)
 {
     const polyMesh& mesh = pMesh_();
     const scalar onAxis = 1e-9*mesh.bounds().mag();
@@ -185,7 +185,7 @@ void Foam::boundaryConstraints::findCyclicAxisPoints(const pointField& points0)
         const vector axis = cyc->rotationAxis()/mag(cyc->rotationAxis());
         for (const label pointi : pp.meshPoints())
         {
-            const vector r = points0[pointi] - cyc->rotationCentre();
+            const vector r = base[pointi] - cyc->rotationCentre();
             if (mag(r - (r & axis)*axis) <= onAxis)
             {
                 points.append(pointi);

@@ -262,6 +262,7 @@ void Foam::boundaryConstraints::readSlipPlanes
 void Foam::boundaryConstraints::sumFaceNormals
 (
     const polyPatch& patch,
+    const sharedPoints& shared,
     const vectorField& nf,
     List<vector>& sum,
     List<scalar>& count
@@ -278,7 +279,6 @@ void Foam::boundaryConstraints::sumFaceNormals
             count[lp] += 1;
         }
     }
-    const sharedPoints shared(pMesh_(), patch.meshPoints());
     shared.sum(sum);
     shared.sum(count);
 }
@@ -293,7 +293,8 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip
 {
     List<vector> sum;
     List<scalar> count;
-    sumFaceNormals(patch, nf0, sum, count);
+    const sharedPoints shared(pMesh_(), patch.meshPoints());
+    sumFaceNormals(patch, shared, nf0, sum, count);
     // Bent smoothly: |sum| of unit normals within (cos curvedSlipAngle, 1)
     // of their count (two faces: within twice the angle of each other;
     // coplanar ones to rounding, 1e-9, keep their own normals)
@@ -313,7 +314,7 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip
     }
     if (&nf != &nf0)
     {
-        sumFaceNormals(patch, nf, sum, count);
+        sumFaceNormals(patch, shared, nf, sum, count);
     }
     vectorField mean(patch.nPoints(), Zero);
     forAll(sum, lp)

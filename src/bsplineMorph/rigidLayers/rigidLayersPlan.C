@@ -450,14 +450,12 @@ void Foam::rigidLayers::plan(const pointField& points0)
     markRigid(inner);
     const label sweeps = nSweeps(nSmooth_, smoothCoeffs_);
     // (a wall point where a processor boundary meets the wall may be owned
-    // by a rank whose faces there are not the wall's)
-    labelList onWall(mesh_.nPoints(), 0);
-    UIndirectList<label>(onWall, wallPoints_) = 1;
-    syncTools::syncPointList(mesh_, onWall, maxEqOp<label>(), label(0));
+    // by a rank whose faces there are not the wall's: pointPatch, synced,
+    // knows it as a wall point there too)
     label nWall = 0;
-    forAll(onWall, pointi)
+    forAll(pointPatch, pointi)
     {
-        nWall += onWall[pointi] && owned[pointi];
+        nWall += pointPatch[pointi] != labelMax && owned[pointi];
     }
     reduce(nWall, sumOp<label>());
     Info<< "rigidLayers: " << nOwnedGlobal(owned, zonePoints_)
