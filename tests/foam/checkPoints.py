@@ -23,7 +23,8 @@
     checkPoints.py wedge WEDGE TIME [PLANAR] [--tol T] [--axial]
                                              an axisymmetric case about the x axis (tests/foam/Alltest.d/
                                              wedge): no point moves across its meridian plane (those on
-                                             the axis move along it), and, given its planar twin (y as
+                                             the axis move along it), the front and back points of a
+                                             meridian position move alike, and, given its planar twin (y as
                                              the radius, empty z), each moves along x and its radius as
                                              the twin's point at the same (x, r) moves along x and y
                                              (T of the domain, default 1e-12); --axial: a case whose
@@ -131,8 +132,9 @@ def wedge(wedgeCase, time, planarCase=None, tol=1e-12, axial=False):
     if planarCase:
         q0, q1 = pointsAt(planarCase, "constant"), pointsAt(planarCase, time)
         planar = {key(p[0], p[1]): i for i, p in enumerate(q0)}
-    across = diff = radial = 0.0
+    across = diff = radial = apart = 0.0
     matched = onAxis = 0
+    pairs = {}
     for a, b in zip(w0, w1):
         r0 = math.hypot(a[1], a[2])
         d = [b[k] - a[k] for k in range(3)]
@@ -146,6 +148,8 @@ def wedge(wedgeCase, time, planarCase=None, tol=1e-12, axial=False):
             across = max(across, math.hypot(d[1], d[2]))
             dr = 0.0
         radial = max(radial, abs(dr))
+        other = pairs.setdefault(key(a[0], r0), (d[0], dr))
+        apart = max(apart, abs(other[0] - d[0]), abs(other[1] - dr))
         if planarCase:
             j = planar.get(key(a[0], r0))
             if j is not None:
@@ -154,6 +158,8 @@ def wedge(wedgeCase, time, planarCase=None, tol=1e-12, axial=False):
                 diff = max(diff, abs(d[0] - e[0]), abs(dr - e[1]))
     check(across <= tol*size, "no point moves across its meridian plane, the %d on the axis move along "
           "it (largest departure %.2e <= %g x domain %.3g)" % (onAxis, across, tol, size))
+    check(apart <= tol*size, "the front and back points of each of the %d meridian positions move alike "
+          "along x and the radius (largest difference %.2e <= %g x %.3g)" % (len(pairs), apart, tol, size))
     if axial:
         moved = max(abs(b[0] - a[0]) for a, b in zip(w0, w1))
         check(radial <= tol*size and moved > 1e-3*size, "every point moves along the axis only (largest "

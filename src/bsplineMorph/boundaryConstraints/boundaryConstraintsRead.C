@@ -32,6 +32,31 @@ Description
 
 #include <cmath>
 
+// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
+
+namespace
+{
+    //- The names in set on any rank, sorted (collective)
+    Foam::wordList allNames(Foam::wordHashSet& set)
+    {
+        using namespace Foam;
+        Pstream::combineGather(set, HashSetOps::plusEqOp<word>());
+        Pstream::combineScatter(set);
+        return set.sortedToc();
+    }
+
+    //- The names in set on any rank not yet in warned, sorted, then added
+    //  to it (collective)
+    Foam::wordList toWarnOf(Foam::wordHashSet& set, Foam::wordHashSet& warned)
+    {
+        allNames(set);
+        set -= warned;
+        warned += set;
+        return set.sortedToc();
+    }
+}
+
+
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
 void Foam::boundaryConstraints::resetPointArrays()
@@ -346,12 +371,10 @@ void Foam::boundaryConstraints::checkPrescribed
     // reach any arithmetic (with FOAM_SIGFPE a NaN comparison traps)
     if (any[0] > 0)
     {
-        Pstream::combineGather(nonFinite, HashSetOps::plusEqOp<word>());
-        Pstream::combineScatter(nonFinite);
         FatalErrorInFunction
             << "pointDisplacement has non-finite (NaN or Inf) or huge (over 1e8"
             << " times the mesh's bounding-box diagonal) values on patches "
-            << flatOutput(nonFinite.sortedToc()) << " at time "
+            << flatOutput(allNames(nonFinite)) << " at time "
             << mesh.time().timeName() << "; the mesh is not moved"
             << exit(FatalError);
     }
@@ -363,13 +386,11 @@ void Foam::boundaryConstraints::checkPrescribed
     {
         return;
     }
-    Pstream::combineGather(emptyDirection, HashSetOps::plusEqOp<word>());
-    Pstream::combineScatter(emptyDirection);
-    emptyDirection -= warnedEmptyDirection_;
-    if (emptyDirection.size())
+    const wordList patches(toWarnOf(emptyDirection, warnedEmptyDirection_));
+    if (patches.size())
     {
         OStringStream names;
-        for (const word& name : emptyDirection.sortedToc())
+        for (const word& name : patches)
         {
             names<< ' ' << name;
         }
@@ -387,7 +408,67 @@ void Foam::boundaryConstraints::checkPrescribed
             << " mesh moves "
             << (axisymmetric ? "along its axis and radii" : "in its plane")
             << " only)" << endl;
-        warnedEmptyDirection_ += emptyDirection;
+    }
+}
+
+
+void Foam::boundaryConstraints::meanFrontBack()
+{
+    // (after the sync: a pair's values, and so their mean, are the same on
+    // every rank that holds it; a difference is worth a warning on the
+    // terms of readFixedPatch's across the frame)
+    const solutionFrame& frame = *frame_;
+    const scalar roundOff = 1e-10*pMesh_().bounds().mag();
+    const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
+    wordHashSet differ;
+    scalar most = 0;
+    for (const labelPair& pq : frame.meridianPairs())
+    {
+        const label p = pq.first();
+        const label q = pq.second();
+        if (!fixedSync_[p] || !fixedSync_[q])
+        {
+            continue;
+        }
+        vector bp[3], bq[3];
+        frame.basis(p, bp);
+        frame.basis(q, bq);
+        const scalar scale = max(mag(value_[p]), mag(value_[q]));
+        for (label k = 0; k < frame.size(); ++k)
+        {
+            const scalar vp = bp[k] & value_[p];
+            const scalar vq = bq[k] & value_[q];
+            const scalar mean = 0.5*(vp + vq);
+            value_[p] += (mean - vp)*bp[k];
+            value_[q] += (mean - vq)*bq[k];
+            const scalar d = mag(vp - vq);
+            if (d > roundOff && d > 1e-6*scale)
+            {
+                differ.insert(patches[fixedSync_[p] - 1].name());
+                differ.insert(patches[fixedSync_[q] - 1].name());
+                most = max(most, d);
+            }
+        }
+    }
+
+    scalarList none;
+    scalarList any({scalar(differ.size()), most});
+    sumsAndMaxima(none, any);
+    if (any[0] == 0)
+    {
+        return;
+    }
+    const wordList names(toWarnOf(differ, warnedFrontBack_));
+    if (names.size())
+    {
+        WarningInFunction
+            << "pointDisplacement prescribes different displacements to the"
+            << " front and back points of this axisymmetric (wedge) case on"
+            << " patches " << flatOutput(names) << " (up to "
+            << any[1] << " apart along the axis or radius), at time "
+            << pMesh_().time().timeName() << ": a motion that is not"
+            << " axisymmetric (e.g. a tilt across the axis). Both points of"
+            << " each pair take the mean of their values" << endl;
     }
 }
 
@@ -459,6 +540,10 @@ void Foam::boundaryConstraints::update
     }
     conditionPoints_->combineMesh(value_, maxMagSqrEqOp<vector>(), vector::zero);
     conditionPoints_->combineMesh(slide_, combineConstraintsEqOp(), pointConstraint());
+    if (frame_->axisymmetric())
+    {
+        meanFrontBack();
+    }
 
     for (const label pointi : boundaryPoints_)
     {

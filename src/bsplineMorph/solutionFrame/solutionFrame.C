@@ -192,6 +192,41 @@ Foam::solutionFrame::solutionFrame
         }
     }
     axisPoints_.transfer(axisPoints);
+
+    // The front and back points of each meridian position: the ends of an
+    // edge from one wedge patch to another, off the axis (a wedge cell's
+    // edges across the wedge; each cell holding one holds both ends, so
+    // every rank that holds a point holds its partner)
+    labelList onWedge(mesh.nPoints(), -1);
+    for (const polyPatch& pp : mesh.boundaryMesh())
+    {
+        if (isA<wedgePolyPatch>(pp))
+        {
+            UIndirectList<label>(onWedge, pp.meshPoints()) = pp.index();
+        }
+    }
+    labelList partner(mesh.nPoints(), -1);
+    DynamicList<labelPair> pairs;
+    for (const face& f : mesh.faces())
+    {
+        forAll(f, i)
+        {
+            const label p = f[i];
+            const label q = f.nextLabel(i);
+            if
+            (
+                onWedge[p] >= 0 && onWedge[q] >= 0 && onWedge[p] != onWedge[q]
+             && partner[p] < 0 && radial_[p] != vector::zero
+             && radial_[q] != vector::zero
+            )
+            {
+                partner[p] = q;
+                partner[q] = p;
+                pairs.append(labelPair(min(p, q), max(p, q)));
+            }
+        }
+    }
+    meridianPairs_.transfer(pairs);
 }
 
 
