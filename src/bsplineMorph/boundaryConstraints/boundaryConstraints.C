@@ -50,6 +50,21 @@ namespace
         }
         return labelList(std::move(points));
     }
+
+    //- The cyclic coupling of a patch: the patch itself (a cyclic, not
+    //  split over ranks), the cyclic a processorCyclic is part of, else none
+    const Foam::cyclicPolyPatch* cyclicCoupling(const Foam::polyPatch& pp)
+    {
+        using namespace Foam;
+        if (isA<processorCyclicPolyPatch>(pp))
+        {
+            return isA<cyclicPolyPatch>
+            (
+                refCast<const processorCyclicPolyPatch>(pp).referPatch()
+            );
+        }
+        return isA<processorPolyPatch>(pp) ? nullptr : isA<cyclicPolyPatch>(pp);
+    }
 }
 
 
@@ -144,10 +159,7 @@ Foam::boundaryConstraints::boundaryConstraints
     labelList joined(mesh.nPoints(), 0);
     for (const polyPatch& pp : mesh.boundaryMesh())
     {
-        const bool cyclicCoupling =
-            isA<processorCyclicPolyPatch>(pp)
-         || (isA<cyclicPolyPatch>(pp) && !isA<processorPolyPatch>(pp));
-        if (cyclicCoupling)
+        if (cyclicCoupling(pp))
         {
             UIndirectList<label>(joined, pp.meshPoints()) = 1;
         }
@@ -171,13 +183,7 @@ void Foam::boundaryConstraints::findCyclicAxisPoints(const pointField& base)
     DynamicList<vector> axes;
     for (const polyPatch& pp : mesh.boundaryMesh())
     {
-        const cyclicPolyPatch* cyc =
-            isA<processorCyclicPolyPatch>(pp)
-          ? isA<cyclicPolyPatch>
-            (
-                refCast<const processorCyclicPolyPatch>(pp).referPatch()
-            )
-          : isA<processorPolyPatch>(pp) ? nullptr : isA<cyclicPolyPatch>(pp);
+        const cyclicPolyPatch* cyc = cyclicCoupling(pp);
         if (!cyc || cyc->transform() != coupledPolyPatch::ROTATIONAL)
         {
             continue;
