@@ -166,6 +166,23 @@ Foam::boundaryConstraints::boundaryConstraints
     }
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
+    if (nCyclicGlobal_ > 0)
+    {
+        // (the patches in order: the last that fixes a point wins; over the
+        // point's own copies on other ranks, never through a transform)
+        labelList own(mesh.nPoints(), 0);
+        for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
+        {
+            if (!pf.patch().coupled() && pf.type() != "empty" && pf.fixesValue())
+            {
+                UIndirectList<label>(own, pf.patch().meshPoints()) =
+                    pf.patch().index() + 1;
+            }
+        }
+        sharedPoints(mesh, cyclicPoints_, true)
+            .combineMesh(own, maxEqOp<label>(), label(0));
+        cyclicOwnFixed_ = UIndirectList<label>(own, cyclicPoints_);
+    }
     findCyclicAxisPoints(base);
 
     readSlipPlanes(pointDisplacement, points0, base);

@@ -54,6 +54,23 @@ namespace
         warned += set;
         return set.sortedToc();
     }
+
+    //- toWarnOf, gathered only when a rank has a name; most: the largest
+    //  of every rank's (collective)
+    Foam::wordList toWarnOf
+    (
+        Foam::wordHashSet& set,
+        Foam::scalar& most,
+        Foam::wordHashSet& warned
+    )
+    {
+        using namespace Foam;
+        scalarList none;
+        scalarList any({scalar(set.size()), most});
+        sumsAndMaxima(none, any);
+        most = any[1];
+        return any[0] > 0 ? toWarnOf(set, warned) : wordList();
+    }
 }
 
 
@@ -451,24 +468,69 @@ void Foam::boundaryConstraints::meanFrontBack()
         }
     }
 
-    scalarList none;
-    scalarList any({scalar(differ.size()), most});
-    sumsAndMaxima(none, any);
-    if (any[0] == 0)
-    {
-        return;
-    }
-    const wordList names(toWarnOf(differ, warnedFrontBack_));
+    const wordList names(toWarnOf(differ, most, warnedFrontBack_));
     if (names.size())
     {
         WarningInFunction
             << "pointDisplacement prescribes different displacements to the"
             << " front and back points of this axisymmetric (wedge) case on"
             << " patches " << flatOutput(names) << " (up to "
-            << any[1] << " apart along the axis or radius), at time "
+            << most << " apart along the axis or radius), at time "
             << pMesh_().time().timeName() << ": a motion that is not"
             << " axisymmetric (e.g. a tilt across the axis). Both points of"
             << " each pair take the mean of their values" << endl;
+    }
+}
+
+
+void Foam::boundaryConstraints::warnCyclicConflicts
+(
+    const labelUList& ownFixed,
+    const UList<vector>& ownValue
+)
+{
+    // (after the syncs: a point whose index rose above its own patches'
+    // took a later patch's at a partner, its value through the transform)
+    const scalar roundOff = 1e-10*pMesh_().bounds().mag();
+    const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
+    wordHashSet overruled;
+    scalar most = 0;
+    forAll(ownFixed, j)
+    {
+        const label i = ownFixed[j];
+        const label pointi = cyclicPoints_[i];
+        const scalar d = mag(value_[pointi] - ownValue[j]);
+        if
+        (
+            fixedSync_[pointi] > cyclicOwnFixed_[i]
+         && d > roundOff && d > 1e-6*max(mag(value_[pointi]), mag(ownValue[j]))
+        )
+        {
+            overruled.insert
+            (
+                patches[cyclicOwnFixed_[i] - 1].name() + " by "
+              + patches[fixedSync_[pointi] - 1].name()
+            );
+            most = max(most, d);
+        }
+    }
+
+    const wordList pairs(toWarnOf(overruled, most, warnedCyclicConflicts_));
+    if (pairs.size())
+    {
+        OStringStream names;
+        forAll(pairs, k)
+        {
+            names<< (k ? ", " : "") << pairs[k].c_str();
+        }
+        WarningInFunction
+            << "pointDisplacement prescribes different displacements to points"
+            << " that cyclic couplings join (up to " << most << " apart), at"
+            << " time " << pMesh_().time().timeName() << ": patches overruled: "
+            << names.str().c_str() << ". Each joined set takes the value of"
+            << " the last of its patches in the boundary's order; the cells"
+            << " beside the overruled points may fold. Prescribe the coupled"
+            << " sides alike" << endl;
     }
 }
 
@@ -529,6 +591,19 @@ void Foam::boundaryConstraints::update
     // several fixed patches takes the last one's value (in the patches'
     // order, as when one rank holds them all) whichever ranks hold which;
     // so do a cyclic pair's points, through its transform
+    // (a cyclic point its own patch fixes here: its value, to tell whether a
+    // later patch at its partner overrules it with another)
+    DynamicList<label> ownFixed;
+    DynamicList<vector> ownValue;
+    forAll(cyclicOwnFixed_, i)
+    {
+        const label pointi = cyclicPoints_[i];
+        if (cyclicOwnFixed_[i] && fixedSync_[pointi] == cyclicOwnFixed_[i])
+        {
+            ownFixed.append(i);
+            ownValue.append(value_[pointi]);
+        }
+    }
     const labelList mine(UIndirectList<label>(fixedSync_, boundaryPoints_));
     conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
     forAll(boundaryPoints_, i)
@@ -540,6 +615,10 @@ void Foam::boundaryConstraints::update
     }
     conditionPoints_->combineMesh(value_, maxMagSqrEqOp<vector>(), vector::zero);
     conditionPoints_->combineMesh(slide_, combineConstraintsEqOp(), pointConstraint());
+    if (nCyclicGlobal_ > 0)
+    {
+        warnCyclicConflicts(ownFixed, ownValue);
+    }
     if (frame_->axisymmetric())
     {
         meanFrontBack();

@@ -27,7 +27,8 @@ License
 Foam::sharedPoints::sharedPoints
 (
     const polyMesh& mesh,
-    const labelList& meshPoints
+    const labelList& meshPoints,
+    const bool collocated
 )
 :
     mesh_(mesh),
@@ -43,7 +44,8 @@ Foam::sharedPoints::sharedPoints
     {
         if
         (
-            isA<coupledPolyPatch>(pp)
+            !collocated
+         && isA<coupledPolyPatch>(pp)
          && (!isA<processorPolyPatch>(pp) || isA<processorCyclicPolyPatch>(pp))
         )
         {
