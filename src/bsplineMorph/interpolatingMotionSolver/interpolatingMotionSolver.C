@@ -220,62 +220,6 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateInto
 }
 
 
-void Foam::interpolatingMotionSolver::warnUnknownKeywords
-(
-    const wordList& known
-) const
-{
-    const word coeffsName(type() + "Coeffs");
-    const dictionary& dict = coeffDict();
-    wordList all(known);
-    all.append("invertedCells");
-    all.append("rebase");
-    all.append("curvedSlipAngle");
-    all.append("rigidLayers");
-    if (dict.dictName() == coeffsName)
-    {
-        coeffsInput::warnUnknown(dict, all);
-        // The solver's entries beside its coefficients are not read (this
-        // is the dictionary the solver is selected in; coeffDict() a copy)
-        const dictionary& top = *this;
-        for (const word& key : all)
-        {
-            if (top.found(key, keyType::LITERAL))
-            {
-                IOWarningInFunction(top)
-                    << "Entry '" << key << "' beside " << coeffsName
-                    << ": ignored (the solver reads its entries from "
-                    << coeffsName << ")" << endl;
-            }
-        }
-        return;
-    }
-    // Without <type>Coeffs the solver reads the dictionary it is selected in
-    // (OpenFOAM's optionalSubDict): a misspelt <type>Coeffs would drop all of
-    // its entries unread
-    wordList others;
-    for (const word& key : dict.toc())
-    {
-        if (dict.isDict(key) && !coeffsInput::nearest(key, {coeffsName}).empty())
-        {
-            FatalIOErrorInFunction(dict)
-                << "No " << coeffsName << " sub-dictionary, but '" << key
-                << "': did you mean " << coeffsName << "? (its entries would"
-                << " be ignored)" << exit(FatalIOError);
-        }
-        if (key.size() > 6 && key.compare(key.size() - 6, 6, "Coeffs") == 0)
-        {
-            others.append(key);
-        }
-    }
-    // (and what dynamicMotionSolverFvMesh reads there, and other solvers'
-    // coefficients)
-    all.append(wordList({"dynamicFvMesh", "motionSolverLibs", "motionSolver", "solver", "solvers"}));
-    all.append(others);
-    coeffsInput::warnUnknown(dict, all);
-}
-
-
 void Foam::interpolatingMotionSolver::plan
 (
     std::unique_ptr<boundaryInterpolator>& interpolator,

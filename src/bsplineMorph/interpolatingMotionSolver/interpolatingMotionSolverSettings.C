@@ -1,0 +1,114 @@
+/*---------------------------------------------------------------------------*\
+  =========                 |
+  \\      /  F ield         | bsplineMorph: multilevel B-spline mesh morphing
+   \\    /   O peration     |
+    \\  /    A nd           | Copyright (C) 2026 bsplineMorph developers
+     \\/     M anipulation  |
+-------------------------------------------------------------------------------
+License
+    This file is part of bsplineMorph, built on OpenFOAM.
+
+    bsplineMorph is free software: you can redistribute it and/or modify it
+    under the terms of the GNU General Public License as published by the
+    Free Software Foundation, either version 3 of the License, or (at your
+    option) any later version. See <http://www.gnu.org/licenses/>.
+
+Description
+    interpolatingMotionSolver's settings: the keywords of <type>Coeffs that
+    no one reads, and dynamicMeshDict changed during a run.
+
+\*---------------------------------------------------------------------------*/
+
+#include "interpolatingMotionSolver.H"
+#include "coeffsInput.H"
+#include "OStringStream.H"
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::interpolatingMotionSolver::warnUnknownKeywords
+(
+    const wordList& known
+) const
+{
+    const word coeffsName(type() + "Coeffs");
+    const dictionary& dict = coeffDict();
+    wordList all(known);
+    all.append("invertedCells");
+    all.append("rebase");
+    all.append("curvedSlipAngle");
+    all.append("rigidLayers");
+    if (dict.dictName() == coeffsName)
+    {
+        coeffsInput::warnUnknown(dict, all);
+        // The solver's entries beside its coefficients are not read (this
+        // is the dictionary the solver is selected in; coeffDict() a copy)
+        const dictionary& top = *this;
+        for (const word& key : all)
+        {
+            if (top.found(key, keyType::LITERAL))
+            {
+                IOWarningInFunction(top)
+                    << "Entry '" << key << "' beside " << coeffsName
+                    << ": ignored (the solver reads its entries from "
+                    << coeffsName << ")" << endl;
+            }
+        }
+        return;
+    }
+    // Without <type>Coeffs the solver reads the dictionary it is selected in
+    // (OpenFOAM's optionalSubDict): a misspelt <type>Coeffs would drop all of
+    // its entries unread
+    wordList others;
+    for (const word& key : dict.toc())
+    {
+        if (dict.isDict(key) && !coeffsInput::nearest(key, {coeffsName}).empty())
+        {
+            FatalIOErrorInFunction(dict)
+                << "No " << coeffsName << " sub-dictionary, but '" << key
+                << "': did you mean " << coeffsName << "? (its entries would"
+                << " be ignored)" << exit(FatalIOError);
+        }
+        if (key.size() > 6 && key.compare(key.size() - 6, 6, "Coeffs") == 0)
+        {
+            others.append(key);
+        }
+    }
+    // (and what dynamicMotionSolverFvMesh reads there, and other solvers'
+    // coefficients: a solver switched without its own runs with defaults)
+    if (others.size())
+    {
+        IOWarningInFunction(dict)
+            << "No " << coeffsName << ": " << type() << " reads its settings"
+            << " from this dictionary itself (its defaults where it has none);"
+            << " the other solvers' coefficients " << flatOutput(others)
+            << " are not read" << endl;
+    }
+    all.append(wordList({"dynamicFvMesh", "motionSolverLibs", "motionSolver", "solver", "solvers"}));
+    all.append(others);
+    coeffsInput::warnUnknown(dict, all);
+}
+
+
+bool Foam::interpolatingMotionSolver::read()
+{
+    OStringStream before;
+    before<< coeffDict();
+    if (!displacementMotionSolver::read())
+    {
+        return false;
+    }
+    OStringStream after;
+    after<< coeffDict();
+    if (after.str() != before.str())
+    {
+        WarningInFunction
+            << type() << ": its settings in " << objectPath() << " changed at"
+            << " time " << mesh().time().timeName() << ": they are read at the"
+            << " start only; the run goes on with those it started with"
+            << " (restart it to apply the new ones)" << endl;
+    }
+    return true;
+}
+
+
+// ************************************************************************* //
