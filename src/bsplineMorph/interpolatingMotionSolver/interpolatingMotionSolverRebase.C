@@ -31,6 +31,8 @@ Description
 #include "interpolatingMotionSolver.H"
 #include "calculatedPointPatchFields.H"
 
+#include <algorithm>
+
 // * * * * * * * * * * * * * * * Local Constants * * * * * * * * * * * * * * //
 
 namespace Foam
@@ -75,10 +77,6 @@ namespace
 
 void Foam::interpolatingMotionSolver::readBase(const word& type)
 {
-    if (!rebase_)
-    {
-        return;
-    }
     const Time& runTime = mesh().time();
     IOobject io
     (
@@ -89,6 +87,16 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
         IOobject::AUTO_WRITE
     );
     const bool found = io.typeHeaderOk<pointVectorField>(true);
+    if (!rebase_)
+    {
+        if (returnReduce(found, orOp<bool>()))
+        {
+            Info<< type << ": rebase off: " << morphBaseName << " in "
+                << runTime.timeName() << " is not read; morphing from the"
+                << " initial mesh" << endl;
+        }
+        return;
+    }
     if (!returnReduce(found, orOp<bool>()))
     {
         // (a run that rebased writes its base at every later write time: on
@@ -139,6 +147,29 @@ void Foam::interpolatingMotionSolver::readBase(const word& type)
             << runTime.timeName() << " its moved points (decomposePar"
             << " -latestTime, or -time " << runTime.timeName() << " alone,"
             << " decomposes that time's mesh), or remove " << morphBaseName
+            << " from " << runTime.timeName() << " to morph from the initial"
+            << " mesh" << exit(FatalError);
+    }
+    // The base is a mesh the run morphed from: none of its cells inverted
+    // (a base of other points, or of these in another order, inverts them;
+    // with invertedCells warn a run may have gone on with some)
+    baseVolumes_ = cellVolumesOf(base());
+    const label nInverted = returnReduce
+    (
+        label(std::count_if
+        (
+            baseVolumes_.cbegin(), baseVolumes_.cend(),
+            [](const scalar v) { return !(v > 0); }
+        )),
+        sumOp<label>()
+    );
+    if (nInverted && invertedCellsFatal_)
+    {
+        FatalErrorInFunction
+            << "rebase on: " << runTime.relativePath(readFrom).c_str()
+            << " inverts " << nInverted << " cells of this mesh: it is not the"
+            << " base of a morph of this mesh (its points were renumbered, or"
+            << " it comes from another mesh). Remove " << morphBaseName
             << " from " << runTime.timeName() << " to morph from the initial"
             << " mesh" << exit(FatalError);
     }
