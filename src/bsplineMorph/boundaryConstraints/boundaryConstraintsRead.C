@@ -160,7 +160,9 @@ void Foam::boundaryConstraints::readFixedPatch
                 nonFinite.insert(pp.name());
             }
         }
-        if (twoD)
+        // (an axisymmetric mesh's front and back points: by pairs, after
+        // the sync, in meanFrontBack)
+        if (twoD && !frame.paired(pointi))
         {
             const scalar across =
                 mag(values[i] - frame.inFrame(pointi, values[i]));
@@ -403,9 +405,15 @@ void Foam::boundaryConstraints::checkPrescribed
     {
         return;
     }
-    const wordList patches(toWarnOf(emptyDirection, warnedEmptyDirection_));
+    warnAcrossFrame(toWarnOf(emptyDirection, warnedEmptyDirection_));
+}
+
+
+void Foam::boundaryConstraints::warnAcrossFrame(const wordList& patches) const
+{
     if (patches.size())
     {
+        const polyMesh& mesh = pMesh_();
         OStringStream names;
         for (const word& name : patches)
         {
@@ -433,11 +441,14 @@ void Foam::boundaryConstraints::meanFrontBack()
 {
     // (after the sync: a pair's values, and so their mean, are the same on
     // every rank that holds it; a difference is worth a warning on the
-    // terms of readFixedPatch's across the frame)
+    // terms of readFixedPatch's across the frame). Across the meridian
+    // planes, the mirror part of the pair's values (opposite components:
+    // a radial motion given as one Cartesian vector) is no motion around
+    // the axis; the mean is, and is warned about
     const solutionFrame& frame = *frame_;
     const scalar roundOff = 1e-10*pMesh_().bounds().mag();
     const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
-    wordHashSet differ;
+    wordHashSet differ, around;
     scalar most = 0;
     for (const labelPair& pq : frame.meridianPairs())
     {
@@ -451,6 +462,13 @@ void Foam::boundaryConstraints::meanFrontBack()
         frame.basis(p, bp);
         frame.basis(q, bq);
         const scalar scale = max(mag(value_[p]), mag(value_[q]));
+        const scalar swirl =
+            0.5*mag((value_[p] & (bp[0] ^ bp[1])) + (value_[q] & (bq[0] ^ bq[1])));
+        if (swirl > roundOff && swirl > 1e-6*scale)
+        {
+            around.insert(patches[fixedSync_[p] - 1].name());
+            around.insert(patches[fixedSync_[q] - 1].name());
+        }
         for (label k = 0; k < frame.size(); ++k)
         {
             const scalar vp = bp[k] & value_[p];
@@ -468,6 +486,8 @@ void Foam::boundaryConstraints::meanFrontBack()
         }
     }
 
+    scalar largest = 0;
+    warnAcrossFrame(toWarnOf(around, largest, warnedEmptyDirection_));
     const wordList names(toWarnOf(differ, most, warnedFrontBack_));
     if (names.size())
     {

@@ -227,6 +227,12 @@ Foam::solutionFrame::solutionFrame
         }
     }
     meridianPairs_.transfer(pairs);
+    paired_.resize(mesh.nPoints());
+    for (const labelPair& pq : meridianPairs_)
+    {
+        paired_.set(pq.first());
+        paired_.set(pq.second());
+    }
 }
 
 
