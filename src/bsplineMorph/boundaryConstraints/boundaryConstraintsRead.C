@@ -606,13 +606,8 @@ void Foam::boundaryConstraints::update
         );
     }
 
-    // The same view of every processor-shared point on all its ranks (the
-    // conditions set values at their patches' points only). A point of
-    // several fixed patches takes the last one's value (in the patches'
-    // order, as when one rank holds them all) whichever ranks hold which;
-    // so do a cyclic pair's points, through its transform
-    // (a cyclic point its own patch fixes here: its value, to tell whether a
-    // later patch at its partner overrules it with another)
+    // A cyclic point its own patch fixes here: its value, to tell whether a
+    // later patch at its partner overrules it with another
     DynamicList<label> ownFixed;
     DynamicList<vector> ownValue;
     forAll(cyclicOwnFixed_, i)
@@ -624,6 +619,12 @@ void Foam::boundaryConstraints::update
             ownValue.append(value_[pointi]);
         }
     }
+
+    // The same view of every processor-shared point on all its ranks (the
+    // conditions set values at their patches' points only). A point of
+    // several fixed patches takes the last one's value (in the patches'
+    // order, as when one rank holds them all) whichever ranks hold which;
+    // so do a cyclic pair's points, through its transform
     const labelList mine(UIndirectList<label>(fixedSync_, boundaryPoints_));
     conditionPoints_->combineMesh(fixedSync_, maxEqOp<label>(), label(0));
     forAll(boundaryPoints_, i)
