@@ -27,29 +27,7 @@ using namespace Foam;
 
 namespace
 {
-    autoPtr<motionSolver> solverOf(const std::string& type, const std::string& coeffs)
-    {
-        IOdictionary dict
-        (
-            IOobject
-            (
-                "dynamicMeshDict",
-                bsmTest::mesh().time().constant(),
-                bsmTest::mesh(),
-                IOobject::NO_READ,
-                IOobject::NO_WRITE,
-                false
-            ),
-            dictionary
-            (
-                IStringStream
-                (
-                    "motionSolver " + type + "; " + type + "Coeffs {" + coeffs + "}"
-                )()
-            )
-        );
-        return motionSolver::New(bsmTest::mesh(), dict);
-    }
+    using bsmTest::solverOf;
 
     autoPtr<motionSolver> bsplineSolver(const std::string& coeffs)
     {

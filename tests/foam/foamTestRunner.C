@@ -20,6 +20,8 @@ Description
 #include "foamTestCase.H"
 #include "IOstreams.H"
 #include "Pstream.H"
+#include "IOdictionary.H"
+#include "IStringStream.H"
 
 namespace
 {
@@ -31,6 +33,35 @@ namespace
 Foam::argList& bsmTest::args() { return *argsPtr; }
 Foam::Time& bsmTest::runTime() { return *runTimePtr; }
 Foam::fvMesh& bsmTest::mesh() { return *meshPtr; }
+
+Foam::autoPtr<Foam::motionSolver> bsmTest::solverOf
+(
+    const std::string& type,
+    const std::string& coeffs
+)
+{
+    using namespace Foam;
+    IOdictionary dict
+    (
+        IOobject
+        (
+            "dynamicMeshDict",
+            mesh().time().constant(),
+            mesh(),
+            IOobject::NO_READ,
+            IOobject::NO_WRITE,
+            false
+        ),
+        dictionary
+        (
+            IStringStream
+            (
+                "motionSolver " + type + "; " + type + "Coeffs {" + coeffs + "}"
+            )()
+        )
+    );
+    return motionSolver::New(mesh(), dict);
+}
 
 
 int main(int argc, char* argv[])

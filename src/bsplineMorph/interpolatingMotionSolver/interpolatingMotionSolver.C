@@ -304,10 +304,6 @@ Foam::interpolatingMotionSolver::curPoints() const
 
 bool Foam::interpolatingMotionSolver::updateControls()
 {
-    // The boundary conditions give the prescribed displacements
-    pointDisplacement_.boundaryFieldRef().updateCoeffs();
-    pointDisplacement_.correctBoundaryConditions();
-
     // The control set, updated in place after the first step (its
     // mesh-sized arrays kept); whether its points or masks changed
     const bool first = !constraintsPtr_;
@@ -434,6 +430,14 @@ void Foam::interpolatingMotionSolver::correctBoundaryValues
     {
         boundaryValues_[i] = displacement[bp[i]];
     }
+    // (updated at the step's start, in solve(): marked so, the
+    // evaluation does not update them again, which would advance a
+    // condition with a state, such as sixDoFRigidBodyDisplacement's body, a
+    // second time past the values the mesh moved with)
+    for (pointPatchVectorField& pf : pointDisplacement_.boundaryFieldRef())
+    {
+        pf.pointPatchField<vector>::updateCoeffs();
+    }
     pointDisplacement_.correctBoundaryConditions();
     forAll(bp, i)
     {
@@ -484,6 +488,10 @@ void Foam::interpolatingMotionSolver::solve()
     interpolationReport report;
     invertedCellCheck::result inverted;
     scalar conditionsSeconds = 0, boundarySeconds = 0, checkSeconds = 0;
+    // The boundary conditions give the prescribed displacements (updated
+    // once a step: a condition with a state advances it at each update)
+    pointDisplacement_.boundaryFieldRef().updateCoeffs();
+    pointDisplacement_.correctBoundaryConditions();
     scalar before = 0;
     // The morph, and (rebase on) once more from the last step's mesh where
     // it would invert cells
