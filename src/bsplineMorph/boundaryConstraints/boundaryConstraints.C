@@ -325,7 +325,7 @@ Foam::boundaryConstraints::boundaryConstraints
 }
 
 
-void Foam::boundaryConstraints::checkCouplings
+void Foam::boundaryConstraints::checkSupported
 (
     const pointVectorField& pointDisplacement,
     const word& solver
@@ -353,6 +353,22 @@ void Foam::boundaryConstraints::checkCouplings
                 << " pointDisplacement conditions prescribe their motion"
                 << " (patchType " << pp.type() << "; type fixedValue; ...)"
                 << " is accepted. The mesh is not moved" << exit(FatalError);
+        }
+        // A condition that moves its points after the solve (projected
+        // onto a surface) would have them left where the morph puts them
+        const pointPatchVectorField& pf = pointDisplacement.boundaryField()[patchi];
+        if (pf.type() == "surfaceSlipDisplacement")
+        {
+            FatalErrorInFunction
+                << pointDisplacement.objectPath() << ", boundaryField "
+                << pp.name() << ": type " << pf.type() << " projects the points"
+                << " a solver moves onto a surface after its solve, which "
+                << solver << " does not do: they would stay where the morph"
+                << " puts them. Use slip, whose points slide along the"
+                << " patch's own faces (flat, or bending smoothly within"
+                << " curvedSlipAngle), or a condition that prescribes the"
+                << " displacement (fixedValue, surfaceDisplacement, ...). The"
+                << " mesh is not moved" << exit(FatalError);
         }
     }
 }

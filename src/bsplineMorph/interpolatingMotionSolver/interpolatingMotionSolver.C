@@ -256,7 +256,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    boundaryConstraints::checkSupported(this->pointDisplacement(), type);
     readBase(type);
 }
 
@@ -276,7 +276,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    boundaryConstraints::checkSupported(this->pointDisplacement(), type);
     readBase(type);
 }
 

@@ -84,6 +84,13 @@ void Foam::interpolatingMotionSolver::warnUnknownKeywords
             << " are not read" << endl;
     }
     all.append(wordList({"dynamicFvMesh", "motionSolverLibs", "motionSolver", "solver", "solvers"}));
+    // (a zone's solver of dynamicMultiMotionSolverFvMesh: its zone, which
+    // the mesh reads; a solver of the whole mesh moves it all, whatever
+    // cellZone says)
+    if (mesh().type() == "dynamicMultiMotionSolverFvMesh")
+    {
+        all.append("cellZone");
+    }
     all.append(others);
     coeffsInput::warnUnknown(dict, all);
 }
