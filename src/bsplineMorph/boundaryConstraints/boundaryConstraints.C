@@ -127,6 +127,7 @@ Foam::boundaryConstraints::boundaryConstraints
     pMesh_(pointDisplacement.mesh()),
     frame_(std::make_shared<const solutionFrame>(pMesh_(), base)),
     nCyclicGlobal_(0),
+    nSurfaceGlobal_(0),
     curvedSlipCos_(std::cos(degToRad(curvedSlipAngle)))
 {
     const polyMesh& mesh = pMesh_();
@@ -166,6 +167,21 @@ Foam::boundaryConstraints::boundaryConstraints
     }
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
+
+    // The points that conditions project onto surfaces
+    labelList onSurface(mesh.nPoints(), 0);
+    DynamicList<label> projecting;
+    for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
+    {
+        if (projectsOntoSurface(pf))
+        {
+            projecting.append(pf.patch().index());
+            UIndirectList<label>(onSurface, pf.patch().meshPoints()) = 1;
+        }
+    }
+    projectingPatches_.transfer(projecting);
+    surfacePoints_ = onAnyRank(mesh, onSurface);
+    nSurfaceGlobal_ = returnReduce(surfacePoints_.size(), sumOp<label>());
     if (nCyclicGlobal_ > 0)
     {
         // (the patches in order: the last that fixes a point wins; over the
@@ -306,6 +322,7 @@ Foam::boundaryConstraints::boundaryConstraints
     boundaryPoints_(bc.boundaryPoints_),
     cyclicPoints_(bc.cyclicPoints_),
     nCyclicGlobal_(bc.nCyclicGlobal_),
+    nSurfaceGlobal_(0),
     curvedSlipCos_(bc.curvedSlipCos_)
 {
     for (const label pointi : bc.projected_)
@@ -313,19 +330,22 @@ Foam::boundaryConstraints::boundaryConstraints
         fixed_[pointi] = true;
         value_[pointi] = displacement[pointi];
     }
-    for (const label pointi : bc.cyclicPoints_)
+    for (const labelList* points : {&bc.cyclicPoints_, &bc.surfacePoints_})
     {
-        if (!bc.fixed_[pointi])
+        for (const label pointi : *points)
         {
-            fixed_[pointi] = true;
-            value_[pointi] = displacement[pointi];
+            if (!bc.fixed_[pointi])
+            {
+                fixed_[pointi] = true;
+                value_[pointi] = displacement[pointi];
+            }
         }
     }
     collectControls();
 }
 
 
-void Foam::boundaryConstraints::checkSupported
+void Foam::boundaryConstraints::checkCouplings
 (
     const pointVectorField& pointDisplacement,
     const word& solver
@@ -353,22 +373,6 @@ void Foam::boundaryConstraints::checkSupported
                 << " pointDisplacement conditions prescribe their motion"
                 << " (patchType " << pp.type() << "; type fixedValue; ...)"
                 << " is accepted. The mesh is not moved" << exit(FatalError);
-        }
-        // A condition that moves its points after the solve (projected
-        // onto a surface) would have them left where the morph puts them
-        const pointPatchVectorField& pf = pointDisplacement.boundaryField()[patchi];
-        if (pf.type() == "surfaceSlipDisplacement")
-        {
-            FatalErrorInFunction
-                << pointDisplacement.objectPath() << ", boundaryField "
-                << pp.name() << ": type " << pf.type() << " projects the points"
-                << " a solver moves onto a surface after its solve, which "
-                << solver << " does not do: they would stay where the morph"
-                << " puts them. Use slip, whose points slide along the"
-                << " patch's own faces (flat, or bending smoothly within"
-                << " curvedSlipAngle), or a condition that prescribes the"
-                << " displacement (fixedValue, surfaceDisplacement, ...). The"
-                << " mesh is not moved" << exit(FatalError);
         }
     }
 }
@@ -492,7 +496,7 @@ Foam::label Foam::boundaryConstraints::nControlGlobal() const
 Foam::label Foam::boundaryConstraints::nRefitGlobal() const
 {
     countGlobal();
-    return nProjectedGlobal_ + nCyclicGlobal_;
+    return nProjectedGlobal_ + nCyclicGlobal_ + nSurfaceGlobal_;
 }
 
 

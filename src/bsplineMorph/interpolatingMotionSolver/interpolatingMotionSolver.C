@@ -256,7 +256,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkSupported(this->pointDisplacement(), type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
     readBase(type);
 }
 
@@ -276,7 +276,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
 {
-    boundaryConstraints::checkSupported(this->pointDisplacement(), type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
     readBase(type);
 }
 
@@ -338,6 +338,36 @@ bool Foam::interpolatingMotionSolver::updateControls()
 }
 
 
+void Foam::interpolatingMotionSolver::projectOntoSurfaces
+(
+    vectorField& displacement
+)
+{
+    // (the conditions' own evaluation, from the displacement from points0,
+    // written at their points; the displacement is pointDisplacement's)
+    for (const label patchi : constraintsPtr_->projectingPatches())
+    {
+        pointPatchVectorField& pf = pointDisplacement_.boundaryFieldRef()[patchi];
+        const labelList& meshPoints = pf.patch().meshPoints();
+        if (shift())
+        {
+            for (const label pointi : meshPoints)
+            {
+                displacement[pointi] += shift_[pointi];
+            }
+        }
+        pf.evaluate();
+        if (shift())
+        {
+            for (const label pointi : meshPoints)
+            {
+                displacement[pointi] -= shift_[pointi];
+            }
+        }
+    }
+}
+
+
 Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
 (
     vectorField& displacement,
@@ -354,6 +384,7 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
     // planes and is continuous across the cyclic pairs
     if (bc.nRefitGlobal() > 0)
     {
+        projectOntoSurfaces(displacement);
         bc.constrain(displacement);
         bc.matchCyclic(displacement);
         std::unique_ptr<boundaryConstraints> refit
