@@ -257,6 +257,10 @@ bool Foam::interpolatingMotionSolver::rebase(const string& why)
     Info<< type() << ": " << why.c_str() << " (rebase on), at time "
         << runTime.timeName()
         << ": rebased on the last step's mesh (planned again)" << endl;
+    if (rigidLayersPtr_)
+    {
+        rigidLayersPtr_->rebased();
+    }
     if (!basePtr_.valid())
     {
         basePtr_.reset

@@ -74,7 +74,8 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     outerDistance_(0),
     planned_(false),
     nSmooth_(0),
-    transformsFinal_(false)
+    transformsFinal_(false),
+    baseRigidValid_(false)
 {
     // (a misspelt keyword named before a required one is found missing)
     coeffsInput::warnUnknown(dict, {"patches", "innerDistance", "outerDistance"});
@@ -517,6 +518,10 @@ void Foam::rigidLayers::addControls
         plan(points0);
         warnFixedInZone(bc);
     }
+    if (shift && !baseRigidValid_)
+    {
+        rigidAtBase(points0, *shift);
+    }
     bc.addPoints(shellPoints_);
 
     // The feet's rigid motions from the prescribed wall displacements alone
@@ -630,7 +635,14 @@ void Foam::rigidLayers::apply
         vector rigid = rigidMotion(j, arm);
         if (w < 1)
         {
-            rigid = d + w*(rigid - d);
+            // (rebased: the base's blend carried on, w of the rigid motion
+            // and 1 - w of the morph since the base, so that where nothing
+            // moved the base is kept)
+            rigid =
+                shift
+              ? (*shift)[pointi] + w*(rigid - baseRigid_[i])
+              + (1 - w)*(d - (*shift)[pointi])
+              : d + w*(rigid - d);
         }
         rigid = frame.inFrame(pointi, rigid);
         newPoints[pointi] = points0[pointi] + rigid;

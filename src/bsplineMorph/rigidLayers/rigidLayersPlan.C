@@ -475,6 +475,29 @@ void Foam::rigidLayers::plan(const pointField& points0)
 }
 
 
+void Foam::rigidLayers::rigidAtBase
+(
+    const pointField& points0,
+    const vectorField& shift
+)
+{
+    // The walls' transforms from their displacement when the base was
+    // taken (the base's: the shift's at their points, which the step then
+    // fitted them from), and the zone's rigid motion with them; the step's
+    // own transforms are fitted after this
+    fitRotations(points0, shift);
+    footDisplacement_ = vectorField(shift, wallPoints_);
+    mapPtr_->distribute(rotation_);
+    mapPtr_->distribute(footDisplacement_);
+    baseRigid_.setSize(zonePoints_.size());
+    forAll(zonePoints_, i)
+    {
+        baseRigid_[i] = rigidMotion(zoneFoot_[i], zoneArm_[i]);
+    }
+    baseRigidValid_ = true;
+}
+
+
 void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
 {
     // Each point's patch: -1 on a listed one, else the first wall that
