@@ -26,6 +26,8 @@ License
 #include "processorPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
 #include "unitConversion.H"
+#include "OStringStream.H"
+#include "IStringStream.H"
 
 #include <algorithm>
 #include <cmath>
@@ -175,12 +177,29 @@ Foam::boundaryConstraints::boundaryConstraints
     {
         if (projectsOntoSurface(pf))
         {
+            // (its projectMode as it writes it: the class keeps it private)
+            OStringStream os;
+            pf.write(os);
+            const dictionary written((IStringStream(os.str()))());
+            if (written.lookupOrDefault<word>("projectMode", word::null) == "pointNormal")
+            {
+                FatalErrorInFunction
+                    << pointDisplacement.objectPath() << ", boundaryField "
+                    << pf.patch().name() << ": " << pf.type() << " with"
+                    << " projectMode pointNormal projects along point normals,"
+                    << " which a rank forms from its own faces only: the points"
+                    << " would differ between decompositions. Use projectMode"
+                    << " nearest or fixedNormal. The mesh is not moved"
+                    << exit(FatalError);
+            }
             projecting.append(pf.patch().index());
             UIndirectList<label>(onSurface, pf.patch().meshPoints()) = 1;
         }
     }
     projectingPatches_.transfer(projecting);
     surfacePoints_ = onAnyRank(mesh, onSurface);
+    onSurface_.resize(mesh.nPoints());
+    onSurface_.set(surfacePoints_);
     nSurfaceGlobal_ = returnReduce(surfacePoints_.size(), sumOp<label>());
     if (nCyclicGlobal_ > 0)
     {
@@ -323,6 +342,7 @@ Foam::boundaryConstraints::boundaryConstraints
     cyclicPoints_(bc.cyclicPoints_),
     nCyclicGlobal_(bc.nCyclicGlobal_),
     nSurfaceGlobal_(0),
+    onSurface_(bc.onSurface_),
     curvedSlipCos_(bc.curvedSlipCos_)
 {
     for (const label pointi : bc.projected_)
@@ -509,6 +529,11 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
         if (fixed_[pointi])
         {
             d = value_[pointi];
+        }
+        else if (onSurface_.test(pointi))
+        {
+            // (their conditions project them: onto the surface, not the
+            // planes they slid on in the first fit)
         }
         else if (slide_[pointi].first() > 0)
         {

@@ -262,7 +262,10 @@ bool Foam::boundaryConstraints::slidesOnFaces(const pointPatchVectorField& pf)
 {
     return
         !pf.patch().coupled() && !pf.fixesValue()
-     && (pf.type() == "slip" || pf.patch().constraintType() == "symmetry");
+     && (
+            pf.type() == "slip" || pf.patch().constraintType() == "symmetry"
+         || projectsOntoSurface(pf)
+        );
 }
 
 

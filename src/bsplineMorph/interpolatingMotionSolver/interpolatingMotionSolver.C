@@ -397,6 +397,9 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
         plan(refitInterpolatorPtr_, *refitPtr_, true, refitChanged);
         const interpolationReport refitReport =
             interpolateInto(*refitInterpolatorPtr_, *refitPtr_, displacement);
+        // (the re-fit meets its fixed points to its tolerance: those the
+        // conditions project onto surfaces are put back onto them)
+        projectOntoSurfaces(displacement);
         report.summary +=
             bc.nCyclicGlobal() > 0
           ? "; re-fit with the projected sliding and cyclic points: "
