@@ -197,10 +197,9 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
     projectingPatches_.transfer(projecting);
-    surfacePoints_ = onAnyRank(mesh, onSurface);
     onSurface_.resize(mesh.nPoints());
-    onSurface_.set(surfacePoints_);
-    nSurfaceGlobal_ = returnReduce(surfacePoints_.size(), sumOp<label>());
+    onSurface_.set(onAnyRank(mesh, onSurface));
+    nSurfaceGlobal_ = returnReduce(label(onSurface_.count()), sumOp<label>());
     if (nCyclicGlobal_ > 0)
     {
         // (the patches in order: the last that fixes a point wins; over the
@@ -350,16 +349,21 @@ Foam::boundaryConstraints::boundaryConstraints
         fixed_[pointi] = true;
         value_[pointi] = displacement[pointi];
     }
-    for (const labelList* points : {&bc.cyclicPoints_, &bc.surfacePoints_})
+    const auto fixUnfixed = [&](const label pointi)
     {
-        for (const label pointi : *points)
+        if (!bc.fixed_[pointi])
         {
-            if (!bc.fixed_[pointi])
-            {
-                fixed_[pointi] = true;
-                value_[pointi] = displacement[pointi];
-            }
+            fixed_[pointi] = true;
+            value_[pointi] = displacement[pointi];
         }
+    };
+    for (const label pointi : bc.cyclicPoints_)
+    {
+        fixUnfixed(pointi);
+    }
+    for (const label pointi : bc.onSurface_)
+    {
+        fixUnfixed(pointi);
     }
     collectControls();
 }

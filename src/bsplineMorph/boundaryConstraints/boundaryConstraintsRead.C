@@ -71,6 +71,23 @@ namespace
         most = any[1];
         return any[0] > 0 ? toWarnOf(set, warned) : wordList();
     }
+
+    //- Whether d, a prescribed displacement's part or two such values'
+    //  difference, is worth a warning: from 1e-10 of the mesh's size
+    //  (meshSize) and 1e-6 of the value on; below either it is the frame's
+    //  own precision (solidBodyMotionDisplacement's rotation about the empty
+    //  axis leaves round-off there; the wedge planes of OpenFOAM's
+    //  movingCone, its vertices given to 8 digits, meet in an axis 7e-9 rad
+    //  off x)
+    bool beyondRoundOff
+    (
+        const Foam::scalar d,
+        const Foam::scalar value,
+        const Foam::scalar meshSize
+    )
+    {
+        return d > 1e-10*meshSize && d > 1e-6*value;
+    }
 }
 
 
@@ -135,17 +152,13 @@ void Foam::boundaryConstraints::readFixedPatch
       ? static_cast<const vectorField&>(*vpf)
       : vectorField(disp, meshPoints)
     );
-    // A component out of the frame is worth a warning from 1e-10 of the
-    // mesh's size and 1e-6 of the value on: below either it is the frame's
-    // own precision (solidBodyMotionDisplacement's rotation about the empty
-    // axis leaves round-off there; the wedge planes of OpenFOAM's movingCone,
-    // its vertices given to 8 digits, meet in an axis 7e-9 rad off x)
+    // A component out of the frame is worth a warning beyond round-off
     const bool twoD = frame.size() < 3;
-    const scalar outOfPlane = 1e-10*pMesh_().bounds().mag();
+    const scalar meshSize = pMesh_().bounds().mag();
     // Values over 1e8 times the mesh's size are no mesh motion (the points
     // would keep a few digits of their cells; near 1e150 their squares
     // overflow): refused with the non-finite ones
-    const scalar huge = 1e8*pMesh_().bounds().mag();
+    const scalar huge = 1e8*meshSize;
     forAll(meshPoints, i)
     {
         const label pointi = meshPoints[i];
@@ -166,7 +179,7 @@ void Foam::boundaryConstraints::readFixedPatch
         {
             const scalar across =
                 mag(values[i] - frame.inFrame(pointi, values[i]));
-            if (across > outOfPlane && across > 1e-6*mag(values[i]))
+            if (beyondRoundOff(across, mag(values[i]), meshSize))
             {
                 emptyDirection.insert(pp.name());
             }
@@ -443,13 +456,13 @@ void Foam::boundaryConstraints::warnAcrossFrame(const wordList& patches) const
 void Foam::boundaryConstraints::meanFrontBack()
 {
     // (after the sync: a pair's values, and so their mean, are the same on
-    // every rank that holds it; a difference is worth a warning on the
-    // terms of readFixedPatch's across the frame). Across the meridian
+    // every rank that holds it; a difference is worth a warning beyond
+    // round-off). Across the meridian
     // planes, the mirror part of the pair's values (opposite components:
     // a radial motion given as one Cartesian vector) is no motion around
     // the axis; the mean is, and is warned about
     const solutionFrame& frame = *frame_;
-    const scalar roundOff = 1e-10*pMesh_().bounds().mag();
+    const scalar meshSize = pMesh_().bounds().mag();
     const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
     wordHashSet differ, around;
     scalar most = 0;
@@ -467,7 +480,7 @@ void Foam::boundaryConstraints::meanFrontBack()
         const scalar scale = max(mag(value_[p]), mag(value_[q]));
         const scalar swirl =
             0.5*mag((value_[p] & (bp[0] ^ bp[1])) + (value_[q] & (bq[0] ^ bq[1])));
-        if (swirl > roundOff && swirl > 1e-6*scale)
+        if (beyondRoundOff(swirl, scale, meshSize))
         {
             around.insert(patches[fixedSync_[p] - 1].name());
             around.insert(patches[fixedSync_[q] - 1].name());
@@ -480,7 +493,7 @@ void Foam::boundaryConstraints::meanFrontBack()
             value_[p] += (mean - vp)*bp[k];
             value_[q] += (mean - vq)*bq[k];
             const scalar d = mag(vp - vq);
-            if (d > roundOff && d > 1e-6*scale)
+            if (beyondRoundOff(d, scale, meshSize))
             {
                 differ.insert(patches[fixedSync_[p] - 1].name());
                 differ.insert(patches[fixedSync_[q] - 1].name());
@@ -514,7 +527,7 @@ void Foam::boundaryConstraints::warnCyclicConflicts
 {
     // (after the syncs: a point whose index rose above its own patches'
     // took a later patch's at a partner, its value through the transform)
-    const scalar roundOff = 1e-10*pMesh_().bounds().mag();
+    const scalar meshSize = pMesh_().bounds().mag();
     const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
     wordHashSet overruled;
     scalar most = 0;
@@ -526,7 +539,7 @@ void Foam::boundaryConstraints::warnCyclicConflicts
         if
         (
             fixedSync_[pointi] > cyclicOwnFixed_[i]
-         && d > roundOff && d > 1e-6*max(mag(value_[pointi]), mag(ownValue[j]))
+         && beyondRoundOff(d, max(mag(value_[pointi]), mag(ownValue[j])), meshSize)
         )
         {
             overruled.insert
