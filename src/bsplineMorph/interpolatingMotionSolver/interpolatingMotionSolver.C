@@ -378,15 +378,20 @@ Foam::interpolationReport Foam::interpolatingMotionSolver::interpolateField
     plan(interpolatorPtr_, bc, false, changed);
     interpolationReport report = interpolateInto(*interpolatorPtr_, bc, displacement);
 
-    // Sliding planes not along the axes: project; cyclic couplings: the
-    // joined points' mean. Then fit again with those points as control
-    // points, so that the interpolant (not only those points) follows the
-    // planes and is continuous across the cyclic pairs
+    // Sliding planes not along the axes and surfaces: project; cyclic
+    // couplings: the joined points' mean; the rigid layers' outermost points
+    // over a projected wall: its rigid motion. Then fit again with those
+    // points as control points, so that the interpolant (not only those
+    // points) follows the planes and is continuous across the cyclic pairs
     if (bc.nRefitGlobal() > 0)
     {
         projectOntoSurfaces(displacement);
         bc.constrain(displacement);
         bc.matchCyclic(displacement);
+        if (rigidLayersPtr_)
+        {
+            rigidLayersPtr_->followSurfaces(points0(), bc.frame(), displacement, shift());
+        }
         std::unique_ptr<boundaryConstraints> refit
         (
             new boundaryConstraints(bc, displacement)

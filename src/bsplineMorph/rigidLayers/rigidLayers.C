@@ -74,6 +74,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     outerDistance_(0),
     planned_(false),
     nSmooth_(0),
+    anySurfaceShell_(false),
     transformsFinal_(false),
     baseRigidValid_(false)
 {
@@ -168,161 +169,6 @@ Foam::autoPtr<Foam::rigidLayers> Foam::rigidLayers::New
 
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
-
-Foam::scalar Foam::rigidLayers::weight
-(
-    const scalar d,
-    const scalar inner,
-    const scalar outer
-)
-{
-    if (d <= inner)
-    {
-        return 1;
-    }
-    if (d >= outer)
-    {
-        return 0;
-    }
-    // (1 - s)^6 (1 + 6 s) of s = (d - inner)/(outer - inner): slope zero at
-    // both ends (C1). The blend adds to the interpolated field w times the
-    // gap between it and the rigid motion, which grows from zero at the
-    // zone's outermost points about as s does: its strain along the normal
-    // is d(s w)/ds times the two fields' difference in strain. That turns
-    // from 1 at inner to at least -0.37 before outer (the quintic smoothstep:
-    // -0.78): this weight falls fast while the gap is still small. Of the
-    // family (1 - s)^k (1 + k s), k = 6 kept every cell of the twisted cube
-    // at amplitude 1.5 from 50^3 to 100^3 cells, where k = 4 and the quintic
-    // folded some, and turns a body in a far field as well as the quintic
-    // (BENCHMARKS.md, "rigidLayers cost")
-    const scalar s = (d - inner)/(outer - inner);
-    const scalar r = 1 - s;
-    const scalar r2 = r*r;
-    return r2*r2*r2*(1 + 6*s);
-}
-
-
-Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
-{
-    // Newton's iteration for the polar decomposition, X <- (g X + X^-T/g)/2
-    // with the determinant scaling g = |det X|^(-1/3) (Higham): quadratic
-    // convergence to the orthogonal factor; M scaled to unit size first
-    const scalar size = mag(M);
-    if (!(size > 0))
-    {
-        return tensor::I;
-    }
-    tensor X = M/size;
-    if (!(det(X) > 1e-12))
-    {
-        return tensor::I;
-    }
-    for (label iter = 0; iter < 100; ++iter)
-    {
-        const scalar detX = det(X);     // (inv(X) is inv(X, det(X)))
-        const scalar g = std::cbrt(1/detX);
-        const tensor next = 0.5*(g*X + inv(X, detX).T()/g);
-        const scalar change = mag(next - X);
-        X = next;
-        if (change < 1e-14)
-        {
-            break;
-        }
-    }
-    // One more unscaled step: orthogonal to round-off
-    return 0.5*(X + inv(X).T());
-}
-
-
-Foam::scalarList Foam::rigidLayers::powerCoeffs(const label n, const scalar tol)
-{
-    // With x = cos(t): ((1 + x)/2)^n = cos(t/2)^(2n)
-    // = 4^-n (C(2n, n) + 2 sum_k C(2n, n - k) cos(k t)), and cos(k t) = T_k(x):
-    // b_k = C(2n, n - k)/4^n, a binomial distribution over k = -n .. n
-    scalarList b(n + 1);
-    b[0] = std::exp(std::lgamma(2.0*n + 1) - 2*std::lgamma(n + 1.0) - n*std::log(4.0));
-    for (label k = 1; k <= n; ++k)
-    {
-        b[k] = b[k - 1]*scalar(n - k + 1)/scalar(n + k);
-    }
-    // The weight of the terms above m, summed from the smallest
-    scalarList above(n + 2, Zero);
-    for (label k = n; k >= 0; --k)
-    {
-        above[k] = above[k + 1] + 2*b[k];
-    }
-    label m = 0;
-    while (m < n && above[m + 1] > tol)
-    {
-        ++m;
-    }
-    scalarList a(m + 1);
-    scalar sum = 0;
-    for (label k = 0; k <= m; ++k)
-    {
-        a[k] = k ? 2*b[k] : b[0];
-        sum += a[k];
-    }
-    for (scalar& ak : a)
-    {
-        ak /= sum;
-    }
-    return a;
-}
-
-
-Foam::label Foam::rigidLayers::nSweeps(const label n, const scalarList& coeffs)
-{
-    const label m = coeffs.size() - 1;
-    return m >= 1 && m < n ? m : n;
-}
-
-
-void Foam::rigidLayers::power
-(
-    tensorField& v,
-    const label n,
-    const scalarList& coeffs,
-    const sweepFunction& sweep,
-    List<tensorField>& work
-)
-{
-    const label m = nSweeps(n, coeffs);
-    if (m == n)
-    {
-        for (label sweepi = 0; sweepi < n; ++sweepi)
-        {
-            sweep(v, v);
-        }
-        return;
-    }
-    // T_0 = v, T_1 = (2A - I) v, T_k+1 = 2 (2A - I) T_k - T_k-1: bounded by
-    // v, since 2A - I has its eigenvalues in [-1, 1]; v <- sum a_k T_k
-    work.setSize(3);
-    tensorField& prev = work[0];
-    tensorField& cur = work[1];
-    tensorField& next = work[2];
-    prev = v;
-    sweep(prev, cur);
-    forAll(v, i)
-    {
-        cur[i] = 2*cur[i] - prev[i];
-        v[i] = coeffs[0]*prev[i] + coeffs[1]*cur[i];
-    }
-    for (label k = 2; k <= m; ++k)
-    {
-        sweep(cur, next);
-        const scalar ak = coeffs[k];
-        forAll(v, i)
-        {
-            next[i] = 4*next[i] - 2*cur[i] - prev[i];
-            v[i] += ak*next[i];
-        }
-        prev.swap(cur);
-        cur.swap(next);
-    }
-}
-
 
 void Foam::rigidLayers::fitRotations
 (
@@ -546,19 +392,26 @@ void Foam::rigidLayers::addControls
     transformsFinal_ = returnReduce(allFixed, andOp<bool>());
     footDisplacement_ = vectorField(prescribed, wallPoints_);
     labelList footFixed(wallPoints_.size());
+    labelList footOnSurface(wallPoints_.size());
     List<pointConstraint> footSlide(wallPoints_.size());
     forAll(wallPoints_, i)
     {
         footFixed[i] = fixed[wallPoints_[i]];
+        footOnSurface[i] = bc.onSurface(wallPoints_[i]);
         footSlide[i] = bc.slides()[wallPoints_[i]];
     }
     mapPtr_->distribute(rotation_);
     mapPtr_->distribute(footDisplacement_);
     mapPtr_->distribute(footFixed);
+    mapPtr_->distribute(footOnSurface);
     mapPtr_->distribute(footSlide);
 
     // The outermost points: fixed at their foot's rigid motion, or sliding
-    // as their foot does (at their distance from a sliding wall)
+    // as their foot does (at their distance from a sliding wall). A foot
+    // that its condition projects onto a curved surface slides on its
+    // tangent plane in the first fit only: its outermost points slide there
+    // too, then follow it (followSurfaces())
+    DynamicList<label> surfaceShell;
     for (const label i : shell_)
     {
         const label pointi = zonePoints_[i];
@@ -570,8 +423,15 @@ void Foam::rigidLayers::addControls
         else if (footSlide[j].first() > 0)
         {
             bc.slide(pointi, footSlide[j]);
+            if (footOnSurface[j])
+            {
+                bc.followSurface(pointi);
+                surfaceShell.append(i);
+            }
         }
     }
+    surfaceShell_.transfer(surfaceShell);
+    anySurfaceShell_ = returnReduce(surfaceShell_.size() > 0, orOp<bool>());
     // Those on patches whose conditions slide them (a wedge or symmetry
     // plane through the zone) when their foot is prescribed: fixed at the
     // rigid motion within their own plane. (Those that their conditions fix
@@ -590,6 +450,48 @@ void Foam::rigidLayers::addControls
         }
     }
     bc.collectControls();
+}
+
+
+void Foam::rigidLayers::fitMovedWalls
+(
+    const pointField& points0,
+    const vectorField& from0
+)
+{
+    fitRotations(points0, from0);
+    footDisplacement_ = vectorField(from0, wallPoints_);
+    mapPtr_->distribute(rotation_);
+    mapPtr_->distribute(footDisplacement_);
+}
+
+
+void Foam::rigidLayers::followSurfaces
+(
+    const pointField& points0,
+    const solutionFrame& frame,
+    vectorField& displacement,
+    const vectorField* shift
+)
+{
+    if (!anySurfaceShell_)
+    {
+        return;
+    }
+    if (shift)
+    {
+        fitMovedWalls(points0, displacement + *shift);
+    }
+    else
+    {
+        fitMovedWalls(points0, displacement);
+    }
+    for (const label i : surfaceShell_)
+    {
+        const label pointi = zonePoints_[i];
+        const vector rigid = frame.inFrame(pointi, rigidMotion(zoneFoot_[i], zoneArm_[i]));
+        displacement[pointi] = shift ? rigid - (*shift)[pointi] : rigid;
+    }
 }
 
 
@@ -615,10 +517,7 @@ void Foam::rigidLayers::apply
     const vectorField& from0 = tfrom0();
     if (!transformsFinal_)
     {
-        fitRotations(points0, from0);
-        footDisplacement_ = vectorField(from0, wallPoints_);
-        mapPtr_->distribute(rotation_);
-        mapPtr_->distribute(footDisplacement_);
+        fitMovedWalls(points0, from0);
     }
 
     forAll(zonePoints_, i)
