@@ -205,7 +205,7 @@ Foam::solutionFrame::solutionFrame
             UIndirectList<label>(onWedge, pp.meshPoints()) = pp.index();
         }
     }
-    labelList partner(mesh.nPoints(), -1);
+    paired_.resize(mesh.nPoints());
     DynamicList<labelPair> pairs;
     for (const face& f : mesh.faces())
     {
@@ -216,23 +216,17 @@ Foam::solutionFrame::solutionFrame
             if
             (
                 onWedge[p] >= 0 && onWedge[q] >= 0 && onWedge[p] != onWedge[q]
-             && partner[p] < 0 && radial_[p] != vector::zero
+             && !paired_.test(p) && radial_[p] != vector::zero
              && radial_[q] != vector::zero
             )
             {
-                partner[p] = q;
-                partner[q] = p;
+                paired_.set(p);
+                paired_.set(q);
                 pairs.append(labelPair(min(p, q), max(p, q)));
             }
         }
     }
     meridianPairs_.transfer(pairs);
-    paired_.resize(mesh.nPoints());
-    for (const labelPair& pq : meridianPairs_)
-    {
-        paired_.set(pq.first());
-        paired_.set(pq.second());
-    }
 }
 
 
