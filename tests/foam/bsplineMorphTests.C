@@ -551,6 +551,11 @@ TEST_CASE("rigidLayers: the fitted rotation is the rotation of a rigid map", "[f
     const tensor Q = rigidLayers::rotation(R & S);
     CHECK(mag(Q - R) < 1e-14);
     CHECK(mag(rigidLayers::rotation(1e-9*S) - tensor::I) < 1e-14);
+    // S itself (a wall at rest) exactly: no round-off for the fit to chase;
+    // a symmetric map that is no such S (a half turn) keeps its rotation
+    CHECK(rigidLayers::rotation(S) == tensor::I);
+    const tensor halfTurn(-2, 0, 0, 0, -1, 0, 0, 0, 0.5);
+    CHECK(mag(rigidLayers::rotation(halfTurn) - tensor(-1, 0, 0, 0, -1, 0, 0, 0, 1)) < 1e-14);
     // Flat S (a plane of edges and its normal, as on a wall face) too
     const tensor flat(1, 0, 0, 0, 1, 0, 0, 0, 1e-3);
     CHECK(mag(rigidLayers::rotation(R & flat) - R) < 1e-13);

@@ -68,6 +68,17 @@ Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
     {
         return tensor::I;
     }
+    // A symmetric positive definite M is its own positive factor: exactly
+    // I (a wall at rest gives such an M bit for bit, and Newton's iteration
+    // would leave values of 1e-80 off the diagonal for the fit to chase)
+    if
+    (
+        M.xy() == M.yx() && M.xz() == M.zx() && M.yz() == M.zy()
+     && M.xx() > 0 && M.xx()*M.yy() - M.xy()*M.yx() > 0 && det(M) > 0
+    )
+    {
+        return tensor::I;
+    }
     tensor X = M/size;
     if (!(det(X) > 1e-12))
     {
