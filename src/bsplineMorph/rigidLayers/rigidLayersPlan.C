@@ -485,10 +485,7 @@ void Foam::rigidLayers::rigidAtBase
     // taken (the base's: the shift's at their points, which the step then
     // fitted them from), and the zone's rigid motion with them; the step's
     // own transforms are fitted after this
-    fitRotations(points0, shift);
-    footDisplacement_ = vectorField(shift, wallPoints_);
-    mapPtr_->distribute(rotation_);
-    mapPtr_->distribute(footDisplacement_);
+    fitMovedWalls(points0, shift);
     baseRigid_.setSize(zonePoints_.size());
     forAll(zonePoints_, i)
     {
