@@ -197,9 +197,19 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
     projectingPatches_.transfer(projecting);
+    projectsHere_.resize(mesh.nPoints());
+    forAll(onSurface, pointi)
+    {
+        projectsHere_.set(pointi, onSurface[pointi]);
+    }
+    const labelList surfacePoints(onAnyRank(mesh, onSurface));
     onSurface_.resize(mesh.nPoints());
-    onSurface_.set(onAnyRank(mesh, onSurface));
+    onSurface_.set(surfacePoints);
     nSurfaceGlobal_ = returnReduce(label(onSurface_.count()), sumOp<label>());
+    if (Pstream::parRun() && nSurfaceGlobal_ > 0)
+    {
+        surfaceSync_ = std::make_shared<const sharedPoints>(mesh, surfacePoints, true);
+    }
     if (nCyclicGlobal_ > 0)
     {
         // (the patches in order: the last that fixes a point wins; over the
@@ -466,6 +476,38 @@ void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
         for (const label pointi : cyclicPoints_)
         {
             if (!fixed_[pointi]) displacement[pointi] = cyclicSum_[pointi];
+        }
+    }
+}
+
+
+void Foam::boundaryConstraints::syncProjected(vectorField& displacement) const
+{
+    // A rank that holds a point of a projecting patch but none of the
+    // patch's faces about it (a point of a floor beside a projected
+    // cylinder) did not project it: it takes the projection of the first
+    // rank in order that did (all projecting ranks computed the same)
+    if (!surfaceSync_)
+    {
+        return;
+    }
+    const vector none(vector::max);
+    surfaceWork_.setSize(displacement.size());
+    for (const label pointi : onSurface_)
+    {
+        surfaceWork_[pointi] = projectsHere_.test(pointi) ? displacement[pointi] : none;
+    }
+    surfaceSync_->combineMesh
+    (
+        surfaceWork_,
+        [&none](vector& x, const vector& y) { if (x == none) x = y; },
+        none
+    );
+    for (const label pointi : onSurface_)
+    {
+        if (!projectsHere_.test(pointi) && surfaceWork_[pointi] != none)
+        {
+            displacement[pointi] = surfaceWork_[pointi];
         }
     }
 }

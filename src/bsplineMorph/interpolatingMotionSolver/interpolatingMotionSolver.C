@@ -365,6 +365,7 @@ void Foam::interpolatingMotionSolver::projectOntoSurfaces
             }
         }
     }
+    constraintsPtr_->syncProjected(displacement);
 }
 
 
