@@ -254,10 +254,12 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
     rebase_(coeffDict().lookupOrDefault<bool>("rebase", false)),
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
-    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
+    checkZoneBorder_(false)
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
     readBase(type);
+    findZoneBorder();
 }
 
 
@@ -274,10 +276,12 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     invertedCellsFatal_(readInvertedCellsFatal(coeffDict())),
     rebase_(coeffDict().lookupOrDefault<bool>("rebase", false)),
     curvedSlipAngle_(readCurvedSlipAngle(coeffDict())),
-    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict()))
+    rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
+    checkZoneBorder_(false)
 {
     boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
     readBase(type);
+    findZoneBorder();
 }
 
 
@@ -333,6 +337,10 @@ bool Foam::interpolatingMotionSolver::updateControls()
             rigidLayersPtr_->checkConstrained(*constraintsPtr_);
         }
         rigidLayersPtr_->addControls(*constraintsPtr_, points0(), shift());
+    }
+    if (checkZoneBorder_)
+    {
+        warnZoneBorder();
     }
     return first || !constraintsPtr_->sameControls(points, mask);
 }

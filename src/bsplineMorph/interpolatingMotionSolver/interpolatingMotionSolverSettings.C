@@ -15,12 +15,16 @@ License
 
 Description
     interpolatingMotionSolver's settings: the keywords of <type>Coeffs that
-    no one reads, and dynamicMeshDict changed during a run.
+    no one reads, dynamicMeshDict changed during a run, and the border of
+    the solver's cellZone in dynamicMultiMotionSolverFvMesh.
 
 \*---------------------------------------------------------------------------*/
 
 #include "interpolatingMotionSolver.H"
 #include "coeffsInput.H"
+#include "boundaryConstraints.H"
+#include "rigidLayers.H"
+#include "syncTools.H"
 #include "OStringStream.H"
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
@@ -93,6 +97,83 @@ void Foam::interpolatingMotionSolver::warnUnknownKeywords
     }
     all.append(others);
     coeffsInput::warnUnknown(dict, all);
+}
+
+
+void Foam::interpolatingMotionSolver::findZoneBorder()
+{
+    // (dynamicMultiMotionSolverFvMesh gives this dictionary its zone; the
+    // mesh stops when there is no such zone)
+    const polyMesh& m = mesh();
+    const dictionary& dict = *this;
+    if (m.type() != "dynamicMultiMotionSolverFvMesh" || !dict.found("cellZone"))
+    {
+        return;
+    }
+    const label zonei = m.cellZones().findZoneID(dict.get<word>("cellZone"));
+    if (zonei < 0)
+    {
+        return;
+    }
+    // Per point: 1 where a cell of the zone holds it, 2 where another does
+    boolList inZone(m.nCells(), false);
+    UIndirectList<bool>(inZone, m.cellZones()[zonei]) = true;
+    labelList side(m.nPoints(), 0);
+    forAll(m.cells(), celli)
+    {
+        for (const label facei : m.cells()[celli])
+        {
+            for (const label pointi : m.faces()[facei])
+            {
+                side[pointi] |= inZone[celli] ? 1 : 2;
+            }
+        }
+    }
+    syncTools::syncPointList(m, side, bitOrEqOp<label>(), label(0));
+    DynamicList<label> border;
+    forAll(side, pointi)
+    {
+        if (side[pointi] == 3)
+        {
+            border.append(pointi);
+        }
+    }
+    zoneBorder_.transfer(border);
+    checkZoneBorder_ = true;
+}
+
+
+void Foam::interpolatingMotionSolver::warnZoneBorder()
+{
+    checkZoneBorder_ = false;
+    const boundaryConstraints& bc = *constraintsPtr_;
+    bitSet rigid(mesh().nPoints());
+    if (rigidLayersPtr_)
+    {
+        rigidLayersPtr_->markRigid(rigid);
+    }
+    label n = 0;
+    for (const label pointi : zoneBorder_)
+    {
+        n += bc.owned()[pointi] && !bc.fixed()[pointi] && !rigid.test(pointi);
+    }
+    zoneBorder_.clear();
+    reduce(n, sumOp<label>());
+    if (n > 0)
+    {
+        const dictionary& dict = *this;
+        WarningInFunction
+            << type() << " (cellZone " << dict.get<word>("cellZone") << "): "
+            << n << " points of the zone's cells are points of cells outside"
+            << " it too, and neither its conditions nor rigidLayers move them."
+            << " dynamicMultiMotionSolverFvMesh gives each of them the motion"
+            << " of the last solver listed whose zone holds it: the cells"
+            << " about them are not those this solver moved and checked"
+            << " (invertedCells), and fold where the zones' motions there"
+            << " differ. Where the other zone moves with a wall, list that wall"
+            << " in rigidLayers with an innerDistance that takes in the"
+            << " zone's border (its points then move with the wall)" << endl;
+    }
 }
 
 
