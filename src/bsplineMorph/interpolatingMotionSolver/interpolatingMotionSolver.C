@@ -25,6 +25,7 @@ License
 #include "coeffsInput.H"
 #include "logPrecision.H"
 #include "hugePageLists.H"
+#include <cmath>
 
 // * * * * * * * * * * * * * * Static Data Members * * * * * * * * * * * * * //
 
@@ -86,6 +87,12 @@ void Foam::interpolatingMotionSolver::refuseInverted
 ) const
 {
     OStringStream what;
+    // (the box's corners in enough digits to tell them apart where the
+    // mesh lies far from the origin)
+    const scalar far = max(mag(r.where.min()), mag(r.where.max()));
+    const scalar span = r.where.mag() > 0 ? r.where.mag() : 1e-3*mesh().bounds().mag();
+    const int digits = 3 + std::ceil(std::log10(max(far, span)/span));
+    what.precision(min(max(digits, int(what.precision())), 17));
     what<< r.nInvalid << " cells at time " << mesh().time().timeName()
         << " (" << r.nNonPositive << " of non-positive volume, "
         << r.nFolded << " folded: positive volume but a face pyramid"
