@@ -57,6 +57,7 @@ struct multilevel<D>::state
     levelApplier<D> applier;            ///< a level's apply and its work arrays
     flatEvaluator<D> evaluator;         ///< the evaluation at the planned points
     fitReport report;                   ///< of the last fit
+    int readPastMax = -1;               ///< whether an evaluation point reads level maxLevels (-1: not asked yet)
 
     state(const communicator& c, const params& p, int nc, pointsView<D> control, std::vector<std::uint8_t> mask,
           pointsView<D> evaluation, std::vector<std::uint8_t> evaluationMask)
@@ -350,6 +351,25 @@ const fitReport& multilevel<D>::fit(const std::vector<double>& values, int trend
         ls.rmsResidual = rms;
         ls.seconds = now() - t1;
         ++k;
+    }
+    // Stopped at maxLevels above the threshold: the fit needs no more
+    // levels where none would be read (asked once, from the next level's
+    // tiles alone, never planned)
+    if (!(maxr <= rep.threshold) && !rep.unread && s.parameters.stopUnread
+        && k == s.parameters.maxLevels && k < 30 && k == int(s.levels.size()))
+    {
+        if (s.readPastMax < 0)
+        {
+            bool mine = false;
+            const std::function<bool(const levelPlan<D>&)> ask = [&](const levelPlan<D>& c)
+            {
+                mine = s.evaluator.reads(c);
+                return false;
+            };
+            planLevel<D>(k, s.comm, s.dom, s.ctrl, s.clusters, s.parameters.bucketTiles, s.parameters.exchange, ask);
+            s.readPastMax = s.comm.max(mine ? 1.0 : 0.0) > 0;
+        }
+        rep.unread = s.readPastMax == 0;
     }
     rep.levels = k;
     s.evaluator.update(s.levels, k, s.affine, s.trend, s.comm.size());

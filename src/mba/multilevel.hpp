@@ -128,7 +128,7 @@ struct fitReport
     double seconds = 0;
     bool converged = false;         ///< maxResidual <= threshold
     /// Stopped above the threshold before a level that no evaluation point
-    /// reads (params::stopUnread)
+    /// reads (params::stopUnread), maxLevels' next included
     bool unread = false;
 };
 

@@ -468,6 +468,26 @@ void stopsBeforeUnreadLevels()
         if (w.evaluationMask[i]) diff = std::max(diff, std::abs(out[i] - ref[i]));
     // (the same coefficients; the flat lattice may fold fewer levels)
     CHECK(diff <= 1e-14*maxAbs(w.v));
+    // Capped at those levels (maxLevels), the fit finds the next unread
+    // too (and again at its next fit); capped a level earlier, the next is
+    // read: the cap stopped it
+    params q = p;
+    q.maxLevels = r.levels;
+    multilevel<D> capped(serial(), q, D, w.c, w.mask, w.e, w.evaluationMask);
+    for (int fit = 0; fit < 2; ++fit)
+    {
+        const fitReport& rc = capped.fit(w.v);
+        CHECK(rc.levels == r.levels);
+        CHECK(rc.unread);
+    }
+    std::vector<double> cappedOut;
+    capped.evaluate(cappedOut);
+    CHECK(cappedOut == out);
+    q.maxLevels = r.levels - 1;
+    multilevel<D> early(serial(), q, D, w.c, w.mask, w.e, w.evaluationMask);
+    const fitReport& re = early.fit(w.v);
+    CHECK(re.levels == r.levels - 1);
+    CHECK(!re.unread);
     // the plan keeps no arrays of the level it stopped before (the full
     // fit's holds its lattice there), and the next fit stops there again
     const std::vector<levelStats> st = m.stats(), stFull = full.stats();

@@ -94,6 +94,23 @@ TEST_CASE("a fit that stops before the unread levels: serial equals simulated ra
         for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
         CHECK(diff <= 1e-12*maxAbs(w.v));
     }
+    // Capped at those levels (maxLevels): every rank finds the next
+    // unread, as serial does
+    pb.p.maxLevels = levels;
+    for (int P : {1, 3, 5})
+    {
+        INFO("capped at " << levels << " levels, ranks " << P << ", partition " << name(how));
+        reports.assign(P, fitReport());
+        const std::vector<double> got = solve<3>(P, how, w.c, w.v, w.mask, w.e, pb);
+        for (const fitReport& r : reports)
+        {
+            CHECK(r.unread);
+            CHECK(r.levels == levels);
+        }
+        double diff = 0;
+        for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(got[i] - ref[i]));
+        CHECK(diff <= 1e-12*maxAbs(w.v));
+    }
 }
 
 TEST_CASE("a level's coefficient tiles alone and its full plan, at the nodes a rank's evaluation points read", "[parallel]")
