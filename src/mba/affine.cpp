@@ -80,12 +80,42 @@ affineFit<D>::affineFit(const communicator& comm, int nc, pointsView<D> x,
         }
     }
     A = comm.sum(A);
+    // Each component's minimum-norm fit about the centroid m of its own
+    // points (in the basis (1, u - m) = M (1, u), M = [1 0; -m I]): where
+    // they leave a direction undetermined (all in a plane), the fit has no
+    // gradient along it wherever that plane lies. Its coefficients in the
+    // common basis: M^T pinv(M A M^T) M rhs (A^-1 where A is regular)
     pinv_.resize(nc*n*n);
     for (int c = 0; c < nc; ++c)
     {
-        const std::vector<double> Ac(A.begin() + c*n*n, A.begin() + (c + 1)*n*n);
-        const std::vector<double> P = pseudoInverse(Ac, n);
-        std::copy(P.begin(), P.end(), pinv_.begin() + c*n*n);
+        const double* Ac = &A[c*n*n];
+        std::vector<double> M(n*n, 0.0);
+        for (int i = 0; i < n; ++i) M[i*n + i] = 1;
+        if (Ac[0] > 0)
+        {
+            for (int i = 1; i < n; ++i) M[i*n] = -Ac[i]/Ac[0];
+        }
+        // MA = M A, then A' = MA M^T
+        std::vector<double> MA(n*n, 0.0), Ap(n*n, 0.0);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j)
+                for (int k = 0; k < n; ++k) MA[i*n + j] += M[i*n + k]*Ac[k*n + j];
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j)
+                for (int k = 0; k < n; ++k) Ap[i*n + j] += MA[i*n + k]*M[j*n + k];
+        const std::vector<double> P = pseudoInverse(Ap, n);
+        // M^T P M
+        std::vector<double> PM(n*n, 0.0);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j)
+                for (int k = 0; k < n; ++k) PM[i*n + j] += P[i*n + k]*M[k*n + j];
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j)
+            {
+                double t = 0;
+                for (int k = 0; k < n; ++k) t += M[k*n + i]*PM[k*n + j];
+                pinv_[(c*n + i)*n + j] = t;
+            }
     }
     coeff_.assign(nc*n, 0.0);
 }

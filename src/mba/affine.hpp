@@ -2,6 +2,8 @@
 // Least-squares affine approximation g(x) = a + B x of vector data (per component
 // with its own point set), the geometric part (normal matrices and their
 // pseudo-inverses) built once, the coefficients solved per set of values.
+// Each component's minimum-norm fit is taken about the centroid of its own
+// points: a direction they leave undetermined gets no gradient.
 #ifndef MBA_AFFINE_HPP
 #define MBA_AFFINE_HPP
 

@@ -177,10 +177,11 @@ multilevel<D>::multilevel(const communicator& comm, const params& p, int nCompon
     if (s.parameters.affine)
     {
         // Centred on the active control points' bounding box (of all ranks:
-        // the same on any decomposition): where they leave a direction
-        // undetermined (all in a plane, on a line, one point), the minimum-
-        // norm fit then has no gradient along it, and a translation of them
-        // translates the mesh
+        // the same on any decomposition), each component's fit about its
+        // own points' centroid: where they leave a direction undetermined
+        // (all in a plane, on a line, one point), the minimum-norm fit then
+        // has no gradient along it, and a translation of them translates
+        // the mesh
         const box<D>& b = controlBox;
         point<D> centre;
         double ext = 0;

@@ -656,6 +656,39 @@ TEST_CASE("degenerate input has documented results", "[core][errors]")
             REQUIRE_THAT(out[3*i + 2], Catch::WithinAbs(0.02, 1e-12));
         }
     }
+    SECTION("one component's control points on a plane off the others' centre: no gradient across it")
+    {
+        // x given on the plane z = 0.1 only (a face pushed along it), z on
+        // that plane and on z = 0.9 (a face that slides): the affine start's
+        // x has no gradient across the plane (the fit about x's own points'
+        // centroid), so x translates the whole domain, and the levels have
+        // nothing to fit; z is affine between the planes
+        auto c = randomPoints<3>(200, 65);
+        std::vector<double> v;
+        std::vector<std::uint8_t> mask;
+        for (std::size_t i = 0; i < c.size(); ++i)
+        {
+            const bool low = i % 2 == 0;
+            c[i][2] = low ? 0.1 : 0.9;
+            v.push_back(low ? 0.1 : 0.0);
+            v.push_back(0.0);
+            v.push_back(low ? 0.2 : 0.0);
+            mask.push_back(low);
+            mask.push_back(low);
+            mask.push_back(1);
+        }
+        multilevel<3> m(serial(), p, 3, c, mask, e);
+        const fitReport& r = m.fit(v);
+        CHECK(r.levels == 0);
+        std::vector<double> out;
+        m.evaluate(out);
+        for (std::size_t i = 0; i < e.size(); ++i)
+        {
+            REQUIRE_THAT(out[3*i], Catch::WithinAbs(0.1, 1e-12));
+            REQUIRE_THAT(out[3*i + 1], Catch::WithinAbs(0.0, 1e-12));
+            REQUIRE_THAT(out[3*i + 2], Catch::WithinAbs(0.2*(0.9 - e[i][2])/0.8, 1e-12));
+        }
+    }
     SECTION("collinear control points, affine start")
     {
         std::vector<point<3>> c;
