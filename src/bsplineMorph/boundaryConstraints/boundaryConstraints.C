@@ -197,18 +197,26 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
     projectingPatches_.transfer(projecting);
-    projectsHere_.resize(mesh.nPoints());
-    forAll(onSurface, pointi)
-    {
-        projectsHere_.set(pointi, onSurface[pointi]);
-    }
-    const labelList surfacePoints(onAnyRank(mesh, onSurface));
     onSurface_.resize(mesh.nPoints());
-    onSurface_.set(surfacePoints);
+    onSurface_.set(onAnyRank(mesh, onSurface));
     nSurfaceGlobal_ = returnReduce(label(onSurface_.count()), sumOp<label>());
-    if (Pstream::parRun() && nSurfaceGlobal_ > 0)
+    if (Pstream::parRun())
     {
-        surfaceSync_ = std::make_shared<const sharedPoints>(mesh, surfacePoints, true);
+        // Per projecting patch: its points on any rank, their copies through
+        // processor patches, and those this rank's faces of it hold
+        surfacePoints_.setSize(projectingPatches_.size());
+        projectsHere_.setSize(projectingPatches_.size());
+        surfaceSync_.resize(projectingPatches_.size());
+        forAll(projectingPatches_, k)
+        {
+            const labelList& meshPoints = mesh.boundaryMesh()[projectingPatches_[k]].meshPoints();
+            projectsHere_[k].resize(mesh.nPoints());
+            projectsHere_[k].set(meshPoints);
+            labelList flag(mesh.nPoints(), 0);
+            UIndirectList<label>(flag, meshPoints) = 1;
+            surfacePoints_[k] = onAnyRank(mesh, flag);
+            surfaceSync_[k] = std::make_shared<const sharedPoints>(mesh, surfacePoints_[k], true);
+        }
     }
     if (nCyclicGlobal_ > 0)
     {
@@ -481,31 +489,38 @@ void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
 }
 
 
-void Foam::boundaryConstraints::syncProjected(vectorField& displacement) const
+void Foam::boundaryConstraints::syncProjected
+(
+    const label k,
+    vectorField& displacement
+) const
 {
-    // A rank that holds a point of a projecting patch but none of the
+    // A rank that holds a point of the projecting patch but none of the
     // patch's faces about it (a point of a floor beside a projected
-    // cylinder) did not project it: it takes the projection of the first
-    // rank in order that did (all projecting ranks computed the same)
-    if (!surfaceSync_)
+    // cylinder) did not project it: it takes the projection of a rank that
+    // did (the point's owner's, else the first rank in order that did; all
+    // that did computed the same, from the values the patches before this
+    // one left, which these syncs keep the same on every rank)
+    if (surfaceSync_.empty())
     {
         return;
     }
     const vector none(vector::max);
+    const bitSet& here = projectsHere_[k];
     surfaceWork_.setSize(displacement.size());
-    for (const label pointi : onSurface_)
+    for (const label pointi : surfacePoints_[k])
     {
-        surfaceWork_[pointi] = projectsHere_.test(pointi) ? displacement[pointi] : none;
+        surfaceWork_[pointi] = here.test(pointi) ? displacement[pointi] : none;
     }
-    surfaceSync_->combineMesh
+    surfaceSync_[k]->combineMesh
     (
         surfaceWork_,
         [&none](vector& x, const vector& y) { if (x == none) x = y; },
         none
     );
-    for (const label pointi : onSurface_)
+    for (const label pointi : surfacePoints_[k])
     {
-        if (!projectsHere_.test(pointi) && surfaceWork_[pointi] != none)
+        if (!here.test(pointi) && surfaceWork_[pointi] != none)
         {
             displacement[pointi] = surfaceWork_[pointi];
         }

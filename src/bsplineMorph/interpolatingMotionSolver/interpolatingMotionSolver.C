@@ -360,9 +360,12 @@ void Foam::interpolatingMotionSolver::projectOntoSurfaces
 {
     // (the conditions' own evaluation, from the displacement from points0,
     // written at their points; the displacement is pointDisplacement's)
-    for (const label patchi : constraintsPtr_->projectingPatches())
+    // (each patch's projection synced before the next one's, which may
+    // project the points they share further: the same chain on every rank)
+    const labelList& patches = constraintsPtr_->projectingPatches();
+    forAll(patches, k)
     {
-        pointPatchVectorField& pf = pointDisplacement_.boundaryFieldRef()[patchi];
+        pointPatchVectorField& pf = pointDisplacement_.boundaryFieldRef()[patches[k]];
         const labelList& meshPoints = pf.patch().meshPoints();
         if (shift())
         {
@@ -379,8 +382,8 @@ void Foam::interpolatingMotionSolver::projectOntoSurfaces
                 displacement[pointi] -= shift_[pointi];
             }
         }
+        constraintsPtr_->syncProjected(k, displacement);
     }
-    constraintsPtr_->syncProjected(displacement);
 }
 
 
