@@ -199,17 +199,60 @@ void Foam::rigidLayers::fitRotations
                 continue;
             }
             tensor M(Zero);
-            forAll(f, edgei)
-            {
-                const label a = f[edgei];
-                const label b = f.nextLabel(edgei);
-                const vector e0 = points0[b] - points0[a];
-                const vector e1 = e0 + displacement[b] - displacement[a];
-                M += e1*e0;
-            }
             const vector A0 = twiceArea(f, points0, nullptr);
             const vector A1 = twiceArea(f, points0, &displacement);
-            M += (A1*A0)/(mag(A0) + VSMALL);
+            if (planeOf_.empty())
+            {
+                forAll(f, edgei)
+                {
+                    const label a = f[edgei];
+                    const label b = f.nextLabel(edgei);
+                    const vector e0 = points0[b] - points0[a];
+                    const vector e1 = e0 + displacement[b] - displacement[a];
+                    M += e1*e0;
+                }
+                M += (A1*A0)/(mag(A0) + VSMALL);
+            }
+            else
+            {
+                // A 2D mesh's face spans its arbitrary thickness: its edges
+                // across it and its normal weigh as its edges in the plane
+                // (their mean length), as a square face's would
+                scalar in0 = 0, in1 = 0;
+                label nIn = 0;
+                forAll(f, edgei)
+                {
+                    const label a = f[edgei];
+                    const label b = f.nextLabel(edgei);
+                    if (!across(a, b))
+                    {
+                        const vector e0 = points0[b] - points0[a];
+                        const vector e1 = e0 + displacement[b] - displacement[a];
+                        M += e1*e0;
+                        in0 += mag(e0);
+                        in1 += mag(e1);
+                        ++nIn;
+                    }
+                }
+                in0 /= max(nIn, 1);
+                in1 /= max(nIn, 1);
+                const auto scaled = [](const vector& v, const scalar length)
+                {
+                    return v*(length/(mag(v) + VSMALL));
+                };
+                forAll(f, edgei)
+                {
+                    const label a = f[edgei];
+                    const label b = f.nextLabel(edgei);
+                    if (across(a, b))
+                    {
+                        const vector e0 = points0[b] - points0[a];
+                        const vector e1 = e0 + displacement[b] - displacement[a];
+                        M += scaled(e1, in1)*scaled(e0, in0);
+                    }
+                }
+                M += scaled(A1, in1)*scaled(A0, in0);
+            }
             for (label i = start; i < end; ++i)
             {
                 rotation_[wallFacePoints_[i]] += M;

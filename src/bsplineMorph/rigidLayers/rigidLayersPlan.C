@@ -147,6 +147,18 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
         onWall.set(pbm[patchi].meshPoints());
     }
     wallPoints_ = onWall.sortedToc();
+    planeOf_.clear();
+    for (const polyPatch& pp : pbm)
+    {
+        if (isA<emptyPolyPatch>(pp) || isA<wedgePolyPatch>(pp))
+        {
+            planeOf_.setSize(mesh_.nPoints(), -1);
+            for (const label pointi : pp.meshPoints())
+            {
+                planeOf_[pointi] = planeOf_[pointi] == -1 ? pp.index() : -2;
+            }
+        }
+    }
     Map<label> wallOf(2*wallPoints_.size());
     forAll(wallPoints_, i)
     {
@@ -163,11 +175,15 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
     for (const label patchi : patchIDs_)
     {
         // (of the undeformed walls: a restart reads a moved mesh)
+        // (in a 2D mesh those in its plane: its thickness is arbitrary)
         const labelList& mp = pbm[patchi].meshPoints();
         for (const edge& e : pbm[patchi].edges())
         {
-            edgeSum += mag(points0[mp[e.end()]] - points0[mp[e.start()]]);
-            ++nEdges;
+            if (!across(mp[e.start()], mp[e.end()]))
+            {
+                edgeSum += mag(points0[mp[e.end()]] - points0[mp[e.start()]]);
+                ++nEdges;
+            }
         }
     }
     edgeSum = returnReduce(edgeSum, sumOp<scalar>());
