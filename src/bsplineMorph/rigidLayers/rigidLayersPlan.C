@@ -147,15 +147,40 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
         onWall.set(pbm[patchi].meshPoints());
     }
     wallPoints_ = onWall.sortedToc();
+    // A 2D mesh's two planes: across its empty direction (whether one
+    // empty patch holds both or each has its own), else its wedge patches
     planeOf_.clear();
-    for (const polyPatch& pp : pbm)
+    const Vector<label>& solutionD = mesh_.solutionD();
+    const label emptyDir =
+        solutionD.x() < 0 ? 0 : solutionD.y() < 0 ? 1 : solutionD.z() < 0 ? 2 : -1;
+    if (emptyDir >= 0)
     {
-        if (isA<emptyPolyPatch>(pp) || isA<wedgePolyPatch>(pp))
+        scalar lo = GREAT, hi = -GREAT;
+        for (const point& p : points0)
         {
-            planeOf_.setSize(mesh_.nPoints(), -1);
-            for (const label pointi : pp.meshPoints())
+            lo = min(lo, p[emptyDir]);
+            hi = max(hi, p[emptyDir]);
+        }
+        reduce(lo, minOp<scalar>());
+        reduce(hi, maxOp<scalar>());
+        const scalar mid = 0.5*(lo + hi);
+        planeOf_.setSize(mesh_.nPoints());
+        forAll(points0, pointi)
+        {
+            planeOf_[pointi] = points0[pointi][emptyDir] < mid ? 0 : 1;
+        }
+    }
+    else
+    {
+        for (const polyPatch& pp : pbm)
+        {
+            if (isA<wedgePolyPatch>(pp))
             {
-                planeOf_[pointi] = planeOf_[pointi] == -1 ? pp.index() : -2;
+                planeOf_.setSize(mesh_.nPoints(), -1);
+                for (const label pointi : pp.meshPoints())
+                {
+                    planeOf_[pointi] = planeOf_[pointi] == -1 ? pp.index() : -2;
+                }
             }
         }
     }
