@@ -197,8 +197,9 @@ Foam::boundaryConstraints::boundaryConstraints
         }
     }
     projectingPatches_.transfer(projecting);
+    surfaceConditionPoints_ = onAnyRank(mesh, onSurface);
     onSurface_.resize(mesh.nPoints());
-    onSurface_.set(onAnyRank(mesh, onSurface));
+    onSurface_.set(surfaceConditionPoints_);
     nSurfaceGlobal_ = returnReduce(label(onSurface_.count()), sumOp<label>());
     if (Pstream::parRun())
     {
@@ -598,27 +599,55 @@ void Foam::boundaryConstraints::constrain(vectorField& displacement) const
         }
         else if (slide_[pointi].first() > 0)
         {
-            // (a constraint along the frame's directions removes exactly
-            // those components: along an axis, exactly zero)
-            bool m[3];
-            if (frame.mask(pointi, slide_[pointi], m))
-            {
-                vector b[3];
-                frame.basis(pointi, b);
-                for (label k = 0; k < frame.size(); ++k)
-                {
-                    if (m[k]) d -= (b[k] & d)*b[k];
-                }
-            }
-            else
-            {
-                d = slide_[pointi].constrainDisplacement(d);
-            }
+            slideOne(frame, pointi, d);
         }
     }
     if (frame_->size() < 3)
     {
         frame_->constrain(displacement);
+    }
+}
+
+
+void Foam::boundaryConstraints::slideOne
+(
+    const solutionFrame& frame,
+    const label pointi,
+    vector& d
+) const
+{
+    // (a constraint along the frame's directions removes exactly those
+    // components: along an axis, exactly zero)
+    bool m[3];
+    if (frame.mask(pointi, slide_[pointi], m))
+    {
+        vector b[3];
+        frame.basis(pointi, b);
+        for (label k = 0; k < frame.size(); ++k)
+        {
+            if (m[k]) d -= (b[k] & d)*b[k];
+        }
+    }
+    else
+    {
+        d = slide_[pointi].constrainDisplacement(d);
+    }
+}
+
+
+void Foam::boundaryConstraints::slideBeforeProjection(vectorField& displacement) const
+{
+    // (the fit meets its control points to its tolerance only: a point of
+    // a projected wall that also lies on a symmetry or slip plane would keep
+    // the fit's error across that plane, which the projection onto the
+    // surface does not remove)
+    const solutionFrame& frame = *frame_;
+    for (const label pointi : surfaceConditionPoints_)
+    {
+        if (!fixed_[pointi] && slide_[pointi].first() > 0)
+        {
+            slideOne(frame, pointi, displacement[pointi]);
+        }
     }
 }
 

@@ -362,6 +362,7 @@ void Foam::interpolatingMotionSolver::projectOntoSurfaces
     // written at their points; the displacement is pointDisplacement's)
     // (each patch's projection synced before the next one's, which may
     // project the points they share further: the same chain on every rank)
+    constraintsPtr_->slideBeforeProjection(displacement);
     const labelList& patches = constraintsPtr_->projectingPatches();
     forAll(patches, k)
     {
