@@ -24,6 +24,11 @@ namespace
 
         static label nUpdates;
 
+        //- The precision of Info's stream at the last update (a condition
+        //  that logs its state, as sixDoFRigidBodyDisplacement does, logs it
+        //  at the case's precision, not the solver's log lines')
+        static label precision;
+
         countingDisplacement(const fixedValuePointPatchVectorField& pf)
         :
             fixedValuePointPatchVectorField(pf)
@@ -51,16 +56,18 @@ namespace
                 return;
             }
             ++nUpdates;
+            precision = Sout.precision();
             vectorField::operator=(vector(0.01*nUpdates, 0, 0));
             fixedValuePointPatchVectorField::updateCoeffs();
         }
     };
 
     label countingDisplacement::nUpdates = 0;
+    label countingDisplacement::precision = 0;
 }
 
 
-TEST_CASE("Each condition is updated once a step, the mesh moved with its values", "[foam][bsplineMorph][rbf]")
+TEST_CASE("Each condition is updated once a step, the mesh moved with its values, at the case's log precision", "[foam][bsplineMorph][rbf]")
 {
     // (and with rebase on, whose step checks the strain first; the walls at
     // 0.01 a step against the box's size 1 rebase on no step here)
@@ -80,12 +87,14 @@ TEST_CASE("Each condition is updated once a step, the mesh moved with its values
         )
     );
     countingDisplacement::nUpdates = 0;
+    const int casePrecision = Sout.precision(13);
     const labelList& meshPoints = pd.boundaryField()[patchi].patch().meshPoints();
     for (label step = 1; step <= 3; ++step)
     {
         solver->solve();
         INFO(type << " {" << coeffs << "}, step " << step);
         CHECK(countingDisplacement::nUpdates == step);
+        CHECK(countingDisplacement::precision == 13);
         // the walls' points where the condition now says (its own values,
         // and pointDisplacement's at its points)
         const vectorField& own = refCast<const countingDisplacement>(pd.boundaryField()[patchi]);
@@ -101,4 +110,5 @@ TEST_CASE("Each condition is updated once a step, the mesh moved with its values
         }
         CHECK(returnReduce(worst, maxOp<scalar>()) <= 1e-15);
     }
+    Sout.precision(casePrecision);
 }
