@@ -200,7 +200,7 @@ Foam::boundaryConstraints::boundaryConstraints
     surfaceConditionPoints_ = onAnyRank(mesh, onSurface);
     onSurface_.resize(mesh.nPoints());
     onSurface_.set(surfaceConditionPoints_);
-    nSurfaceGlobal_ = returnReduce(label(onSurface_.count()), sumOp<label>());
+    nSurfaceGlobal_ = returnReduce(surfaceConditionPoints_.size(), sumOp<label>());
     if (Pstream::parRun())
     {
         // Per projecting patch: its points on any rank, their copies through

@@ -201,14 +201,20 @@ void Foam::rigidLayers::fitRotations
             tensor M(Zero);
             const vector A0 = twiceArea(f, points0, nullptr);
             const vector A1 = twiceArea(f, points0, &displacement);
+            // (edge i of the face, from points0 and moved)
+            vector e0, e1;
+            const auto edgeAt = [&](const label edgei)
+            {
+                const label a = f[edgei];
+                const label b = f.nextLabel(edgei);
+                e0 = points0[b] - points0[a];
+                e1 = e0 + displacement[b] - displacement[a];
+            };
             if (planeOf_.empty())
             {
                 forAll(f, edgei)
                 {
-                    const label a = f[edgei];
-                    const label b = f.nextLabel(edgei);
-                    const vector e0 = points0[b] - points0[a];
-                    const vector e1 = e0 + displacement[b] - displacement[a];
+                    edgeAt(edgei);
                     M += e1*e0;
                 }
                 M += (A1*A0)/(mag(A0) + VSMALL);
@@ -222,12 +228,9 @@ void Foam::rigidLayers::fitRotations
                 label nIn = 0;
                 forAll(f, edgei)
                 {
-                    const label a = f[edgei];
-                    const label b = f.nextLabel(edgei);
-                    if (!across(a, b))
+                    if (!across(f[edgei], f.nextLabel(edgei)))
                     {
-                        const vector e0 = points0[b] - points0[a];
-                        const vector e1 = e0 + displacement[b] - displacement[a];
+                        edgeAt(edgei);
                         M += e1*e0;
                         in0 += mag(e0);
                         in1 += mag(e1);
@@ -242,12 +245,9 @@ void Foam::rigidLayers::fitRotations
                 };
                 forAll(f, edgei)
                 {
-                    const label a = f[edgei];
-                    const label b = f.nextLabel(edgei);
-                    if (across(a, b))
+                    if (across(f[edgei], f.nextLabel(edgei)))
                     {
-                        const vector e0 = points0[b] - points0[a];
-                        const vector e1 = e0 + displacement[b] - displacement[a];
+                        edgeAt(edgei);
                         M += scaled(e1, in1)*scaled(e0, in0);
                     }
                 }
