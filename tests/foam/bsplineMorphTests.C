@@ -542,6 +542,31 @@ TEST_CASE("rigidLayers: the blend weight is 1 inside, 0 outside, C1 between, and
 }
 
 
+TEST_CASE("rigidLayers: a foot on another wall gets half on the bisector, none on the nearest wall or beyond the width", "[foam][rigidLayers]")
+{
+    const scalar width = 0.12;
+    const auto a = [&](const scalar d, const scalar d2) { return rigidLayers::pairShare(d, d2, width); };
+    CHECK(a(0.05, 0.05) == Approx(0.5).epsilon(1e-15));
+    CHECK(a(0, 0) == 0.5);
+    CHECK(a(0, 0.01) == 0);
+    CHECK(a(0.05, 0.05 + width) == Approx(0).margin(1e-15));
+    CHECK(a(0.05, 0.2) == 0);
+    // (1 - t)^2 (1 + 2 t) d^2/(d^2 + d2^2) at t = 1/2: 1/2 of 0.05^2/(0.05^2 + 0.11^2)
+    CHECK(a(0.05, 0.11) == Approx(0.5*0.0025/(0.0025 + 0.0121)).epsilon(1e-14));
+    // Falling from the bisector, and Lipschitz (steps of 1e-6 change it by
+    // at most 1.1e-5: its steepest slope is -1/(2 d), on the bisector)
+    scalar last = 0.5;
+    for (label i = 1; i <= 120000; ++i)
+    {
+        const scalar v = a(0.05, 0.05 + i*1e-6);
+        REQUIRE(v <= last);
+        REQUIRE(last - v < 1.1e-5);
+        last = v;
+    }
+    CHECK(last == Approx(0).margin(1e-15));
+}
+
+
 TEST_CASE("rigidLayers: the fitted rotation is the rotation of a rigid map", "[foam][rigidLayers]")
 {
     // M = R S with S symmetric positive definite: the polar factor is R

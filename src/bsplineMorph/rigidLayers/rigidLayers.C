@@ -461,7 +461,7 @@ void Foam::rigidLayers::addControls
         const label j = zoneFoot_[i];
         if (footFixed[j])
         {
-            bc.fix(pointi, rigidMotion(j, zoneArm_[i]) - (shift ? (*shift)[pointi] : Zero));
+            bc.fix(pointi, zoneRigid(i, &footFixed) - (shift ? (*shift)[pointi] : Zero));
         }
         else if (footSlide[j].first() > 0)
         {
@@ -474,20 +474,65 @@ void Foam::rigidLayers::addControls
         }
     }
     surfaceShell_.transfer(surfaceShell);
-    anySurfaceShell_ = returnReduce(surfaceShell_.size() > 0, orOp<bool>());
+    const List<pointConstraint>& slides = bc.slides();
+    // The points of a sliding listed wall within innerDistance of another
+    // listed wall (where two walls meet in a corner) keep to the other
+    // wall's layers within their own plane: fixed at its foot's rigid
+    // motion where that is prescribed, else sliding as that foot too (and
+    // following it where it is projected onto a surface), so that the
+    // layers of both walls move together
+    DynamicList<label> pairSurface;
+    DynamicList<pointConstraint> pairSurfaceSlide;
+    forAll(zonePair_, i)
+    {
+        const label p = zonePair_[i];
+        const label pointi = zonePoints_[i];
+        if
+        (
+            p < 0 || magSqr(zoneArm_[i]) > 0 || fixed[pointi]
+         || slides[pointi].first() == 0
+        )
+        {
+            continue;
+        }
+        const label j = pairFoot_[p];
+        if (footFixed[j])
+        {
+            const vector r = rigidMotion(j, pairArm_[p]) - (shift ? (*shift)[pointi] : Zero);
+            bc.fix(pointi, slides[pointi].constrainDisplacement(r));
+        }
+        else if (footSlide[j].first() > 0)
+        {
+            pointConstraint pc(slides[pointi]);
+            pc.combine(footSlide[j]);
+            if (footOnSurface[j])
+            {
+                bc.followSurface(pointi);
+                pairSurface.append(i);
+                pairSurfaceSlide.append(slides[pointi]);
+            }
+            bc.slide(pointi, pc);
+        }
+    }
+    pairSurface_.transfer(pairSurface);
+    pairSurfaceSlide_.transfer(pairSurfaceSlide);
+    anySurfaceShell_ = returnReduce
+    (
+        surfaceShell_.size() + pairSurface_.size() > 0,
+        orOp<bool>()
+    );
     // Those on patches whose conditions slide them (a wedge or symmetry
     // plane through the zone) when their foot is prescribed: fixed at the
     // rigid motion within their own plane. (Those that their conditions fix
     // keep their value; those of sliding feet, and on patches that neither
     // fix nor slide, are no control points.)
-    const List<pointConstraint>& slides = bc.slides();
     for (const label i : patchShell_)
     {
         const label pointi = zonePoints_[i];
         const label j = zoneFoot_[i];
         if (!fixed[pointi] && slides[pointi].first() > 0 && footFixed[j])
         {
-            vector r = rigidMotion(j, zoneArm_[i]) - (shift ? (*shift)[pointi] : Zero);
+            vector r = zoneRigid(i, &footFixed) - (shift ? (*shift)[pointi] : Zero);
             r = slides[pointi].constrainDisplacement(r);
             bc.fix(pointi, r);
         }
@@ -532,8 +577,18 @@ void Foam::rigidLayers::followSurfaces
     for (const label i : surfaceShell_)
     {
         const label pointi = zonePoints_[i];
-        const vector rigid = frame.inFrame(pointi, rigidMotion(zoneFoot_[i], zoneArm_[i]));
+        const vector rigid = frame.inFrame(pointi, zoneRigid(i));
         displacement[pointi] = shift ? rigid - (*shift)[pointi] : rigid;
+    }
+    forAll(pairSurface_, k)
+    {
+        const label i = pairSurface_[k];
+        const label pointi = zonePoints_[i];
+        const label p = zonePair_[i];
+        vector rigid = rigidMotion(pairFoot_[p], pairArm_[p]);
+        rigid = shift ? rigid - (*shift)[pointi] : rigid;
+        displacement[pointi] =
+            frame.inFrame(pointi, pairSurfaceSlide_[k].constrainDisplacement(rigid));
     }
 }
 
@@ -570,11 +625,9 @@ void Foam::rigidLayers::apply
         {
             continue;
         }
-        const label j = zoneFoot_[i];
-        const vector& arm = zoneArm_[i];
         const scalar w = zoneWeight_[i];
         const vector& d = from0[pointi];
-        vector rigid = rigidMotion(j, arm);
+        vector rigid = zoneRigid(i);
         if (w < 1)
         {
             // (rebased: the base's blend carried on, w of the rigid motion

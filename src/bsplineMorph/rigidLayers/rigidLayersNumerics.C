@@ -58,6 +58,21 @@ Foam::scalar Foam::rigidLayers::weight
 }
 
 
+Foam::scalar Foam::rigidLayers::pairShare
+(
+    const scalar d,
+    const scalar d2,
+    const scalar width
+)
+{
+    const scalar t = min(max((d2 - d)/width, scalar(0)), scalar(1));
+    const scalar r = 1 - t;
+    const scalar dSqr = d*d;
+    const scalar sum = dSqr + d2*d2;
+    return sum > 0 ? r*r*(1 + 2*t)*dSqr/sum : 0.5;
+}
+
+
 Foam::tensor Foam::rigidLayers::rotation(const tensor& M)
 {
     // Newton's iteration for the polar decomposition, X <- (g X + X^-T/g)/2

@@ -22,109 +22,14 @@ License
 #include "syncTools.H"
 #include "globalIndex.H"
 #include "bitSet.H"
-#include "PstreamBuffers.H"
-#include "indexedOctree.H"
-#include "treeDataPoint.H"
-#include "hugePageLists.H"
 #include "HashOps.H"
 
 #include <algorithm>
 #include <vector>
 
-// The plan of the rigid layers, once per topology: the walls' points, each
-// zone point's foot (the nearest wall point, also on nearby ranks), the
-// zone's outermost points, and the warning about fixed walls in the zone
-
-// * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
-
-namespace Foam
-{
-namespace
-{
-    //- Squared distance from a point to a box (0 inside; large for an
-    //  empty box)
-    scalar distSqrToBox(const point& p, const boundBox& bb)
-    {
-        if (bb.empty())
-        {
-            return GREAT;
-        }
-        scalar s = 0;
-        for (direction d = 0; d < 3; ++d)
-        {
-            const scalar below = bb.min()[d] - p[d];
-            const scalar above = p[d] - bb.max()[d];
-            const scalar out = max(below, above);
-            if (out > 0)
-            {
-                s += out*out;
-            }
-        }
-        return s;
-    }
-
-    //- Whether foot a is preferred to foot b at the same squared distance:
-    //  the lexicographically smaller point, then a copy on this rank (the
-    //  same point on two ranks has the same transform)
-    template<class Candidate>
-    bool preferred(const Candidate& a, const Candidate& b)
-    {
-        for (direction d = 0; d < 3; ++d)
-        {
-            if (a.x[d] != b.x[d])
-            {
-                return a.x[d] < b.x[d];
-            }
-        }
-        return a.local && !b.local;
-    }
-
-    //- The octree's nearest-point search with equal squared distances going
-    //  to preferred(): the octree visits every box no farther than the
-    //  nearest so far, so that one traversal meets every tie
-    template<class Candidate>
-    class nearestPreferredOp
-    {
-        const std::vector<Candidate>& cand_;
-
-    public:
-
-        explicit nearestPreferredOp(const std::vector<Candidate>& cand)
-        :
-            cand_(cand)
-        {}
-
-        void operator()
-        (
-            const labelUList& indices,
-            const point& sample,
-            scalar& nearestDistSqr,
-            label& minIndex,
-            point& nearestPoint
-        ) const
-        {
-            for (const label c : indices)
-            {
-                const scalar distSqr = magSqr(sample - cand_[c].x);
-                if
-                (
-                    distSqr < nearestDistSqr
-                 || (
-                        distSqr == nearestDistSqr && minIndex >= 0
-                     && preferred(cand_[c], cand_[minIndex])
-                    )
-                )
-                {
-                    nearestDistSqr = distSqr;
-                    minIndex = c;
-                    nearestPoint = cand_[c].x;
-                }
-            }
-        }
-    };
-}
-}
-
+// The plan of the rigid layers, once per topology: the walls' points, the
+// zone's outermost points (its feet: rigidLayersFeet.C), and the warning
+// about fixed walls in the zone
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
@@ -266,139 +171,6 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
 }
 
 
-std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
-(
-    const pointField& points0,
-    const globalIndex& wallIndex
-) const
-{
-    const label myProc = Pstream::myProcNo();
-    // Candidate feet: this rank's wall points and those of the other ranks
-    // within outerDistance of this rank's points
-    const scalar outer = outerDistance_;
-    List<boundBox> rankBox(Pstream::nProcs());
-    rankBox[myProc] = boundBox(points0, false);
-    Pstream::gatherList(rankBox);
-    Pstream::scatterList(rankBox);
-
-    std::vector<footCandidate> cand;
-    cand.reserve(wallPoints_.size());
-    forAll(wallPoints_, i)
-    {
-        cand.push_back({wallIndex.toGlobal(i), points0[wallPoints_[i]], true});
-    }
-    if (Pstream::parRun())
-    {
-        PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
-        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
-        {
-            if (proci == myProc)
-            {
-                continue;
-            }
-            DynamicList<label> ids;
-            DynamicList<point> xs;
-            forAll(wallPoints_, i)
-            {
-                const point& x = points0[wallPoints_[i]];
-                if (distSqrToBox(x, rankBox[proci]) <= outer*outer)
-                {
-                    ids.append(wallIndex.toGlobal(i));
-                    xs.append(x);
-                }
-            }
-            UOPstream os(proci, buffers);
-            os << ids << xs;
-        }
-        buffers.finishedSends();
-        for (label proci = 0; proci < Pstream::nProcs(); ++proci)
-        {
-            if (proci == myProc)
-            {
-                continue;
-            }
-            UIPstream is(proci, buffers);
-            labelList ids;
-            List<point> xs;
-            is >> ids >> xs;
-            forAll(ids, i)
-            {
-                cand.push_back({ids[i], xs[i], false});
-            }
-        }
-    }
-
-    return cand;
-}
-
-
-void Foam::rigidLayers::findFeet
-(
-    const pointField& points0,
-    const std::vector<footCandidate>& cand
-)
-{
-    // The candidates in an octree: each point's nearest one within
-    // outerDistance (equal distances go to preferred())
-    zonePoints_.clear();
-    zoneFoot_.clear();
-    zoneWeight_.clear();
-    zoneArm_.clear();
-    if (cand.empty())
-    {
-        return;
-    }
-    pointField candPoints(label(cand.size()));
-    forAll(candPoints, c)
-    {
-        candPoints[c] = cand[c].x;
-    }
-    const treeBoundBox candBox(candPoints);
-    const treeDataPoint shapes(candPoints);
-    const indexedOctree<treeDataPoint> tree
-    (
-        shapes,
-        treeBoundBox(candBox.min() - vector::one*outerDistance_, candBox.max() + vector::one*outerDistance_),
-        10,     // levels
-        10,     // candidates per leaf
-        3       // duplicity
-    );
-
-    DynamicList<label> zone, feet;
-    DynamicList<scalar> weights;
-    DynamicList<vector> arms;
-    const scalar outerSqr = sqr(outerDistance_);
-    const nearestPreferredOp<footCandidate> nearest(cand);
-    forAll(points0, pointi)
-    {
-        const point& x = points0[pointi];
-        if (distSqrToBox(x, candBox) >= outerSqr)
-        {
-            continue;   // (most points of a large mesh: no search)
-        }
-        const pointIndexHit hit = tree.findNearest(x, outerSqr, nearest);
-        if (!hit.hit())
-        {
-            continue;
-        }
-        const label best = hit.index();
-        const scalar bestSqr = magSqr(x - cand[best].x);
-        zone.append(pointi);
-        feet.append(cand[best].globalIndex);
-        weights.append(weight(std::sqrt(bestSqr), innerDistance_, outerDistance_));
-        arms.append(x - cand[best].x);
-    }
-    zonePoints_.transfer(zone);
-    zoneFoot_.transfer(feet);
-    zoneWeight_.transfer(weights);
-    zoneArm_.transfer(arms);
-    // (swept at every step)
-    onHugePages(zonePoints_);
-    onHugePages(zoneFoot_);
-    onHugePages(zoneWeight_);
-    onHugePages(zoneArm_);
-}
-
 
 void Foam::rigidLayers::findOutermost()
 {
@@ -461,16 +233,8 @@ void Foam::rigidLayers::findOutermost()
 void Foam::rigidLayers::plan(const pointField& points0)
 {
     findWallPoints(points0);
-    const globalIndex wallIndex(wallPoints_.size());
-    findFeet(points0, footCandidates(points0, wallIndex));
-    findOutermost();
-    // The feet in compact numbering: this rank's wall points, then the other
-    // ranks' that are feet here
-    List<Map<label>> compactMap;
-    mapPtr_.reset(new mapDistribute(wallIndex, zoneFoot_, compactMap));
-
-    // Each foot's patch: the first listed one that holds the wall point on
-    // any rank (the same on every decomposition)
+    // Each wall point's patch: the first listed one that holds it on any
+    // rank (the same on every decomposition)
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     labelList pointPatch(mesh_.nPoints(), labelMax);
     forAllReverse(patchIDs_, k)
@@ -481,6 +245,28 @@ void Foam::rigidLayers::plan(const pointField& points0)
         }
     }
     syncTools::syncPointList(mesh_, pointPatch, minEqOp<label>(), labelMax);
+    const globalIndex wallIndex(wallPoints_.size());
+    label nNearest = 0;
+    const std::vector<footCandidate> cand
+    (
+        footCandidates(points0, wallIndex, pointPatch, nNearest)
+    );
+    findFeet(points0, cand, nNearest);
+    findOutermost();
+    // The feet in compact numbering: this rank's wall points, then the other
+    // ranks' that are feet here (the nearest feet, then the other walls')
+    List<Map<label>> compactMap;
+    labelList feet(zoneFoot_);
+    feet.append(pairFoot_);
+    mapPtr_.reset(new mapDistribute(wallIndex, feet, compactMap));
+    forAll(zoneFoot_, i)
+    {
+        zoneFoot_[i] = feet[i];
+    }
+    forAll(pairFoot_, p)
+    {
+        pairFoot_[p] = feet[zoneFoot_.size() + p];
+    }
     footPatch_ = labelList(UIndirectList<label>(pointPatch, wallPoints_));
     mapPtr_->distribute(footPatch_);
     planned_ = true;
@@ -513,6 +299,29 @@ void Foam::rigidLayers::plan(const pointField& points0)
         << " smoothed over " << nSmooth_
         << (nSmooth_ == 1 ? " ring" : " rings") << " of faces, in " << sweeps
         << (sweeps == 1 ? " sweep)" : " sweeps)") << endl;
+    // (where listed walls meet)
+    DynamicList<label> paired, pairedOnWall;
+    forAll(zonePair_, i)
+    {
+        if (zonePair_[i] >= 0)
+        {
+            paired.append(zonePoints_[i]);
+            if (magSqr(zoneArm_[i]) == 0)
+            {
+                pairedOnWall.append(zonePoints_[i]);
+            }
+        }
+    }
+    const label nPaired = nOwnedGlobal(owned, paired);
+    if (nPaired)
+    {
+        Info<< "rigidLayers: " << nPaired << " of those points are near two"
+            << " listed walls (where they meet) and blend the two walls' rigid"
+            << " motions; " << nOwnedGlobal(owned, pairedOnWall)
+            << " of them lie on a wall, within innerDistance of the other:"
+            << " where their wall slides, they keep to the other wall's layers"
+            << endl;
+    }
 }
 
 
@@ -530,7 +339,7 @@ void Foam::rigidLayers::rigidAtBase
     baseRigid_.setSize(zonePoints_.size());
     forAll(zonePoints_, i)
     {
-        baseRigid_[i] = rigidMotion(zoneFoot_[i], zoneArm_[i]);
+        baseRigid_[i] = zoneRigid(i);
     }
     baseRigidValid_ = true;
 }
