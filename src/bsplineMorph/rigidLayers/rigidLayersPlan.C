@@ -106,13 +106,20 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
     {
         // (of the undeformed walls: a restart reads a moved mesh)
         // (in a 2D mesh those in its plane: its thickness is arbitrary)
-        const labelList& mp = pbm[patchi].meshPoints();
-        for (const edge& e : pbm[patchi].edges())
+        // (the faces' sides, an edge inside a patch once for each of its
+        // two faces: every face is on one rank, where a patch's edge along
+        // a processor boundary is on both)
+        for (const face& f : pbm[patchi])
         {
-            if (!across(mp[e.start()], mp[e.end()]))
+            forAll(f, i)
             {
-                edgeSum += mag(points0[mp[e.end()]] - points0[mp[e.start()]]);
-                ++nEdges;
+                const label a = f[i];
+                const label b = f.nextLabel(i);
+                if (!across(a, b))
+                {
+                    edgeSum += mag(points0[b] - points0[a]);
+                    ++nEdges;
+                }
             }
         }
     }
