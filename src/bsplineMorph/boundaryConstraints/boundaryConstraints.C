@@ -173,8 +173,10 @@ Foam::boundaryConstraints::boundaryConstraints
     // The points that conditions project onto surfaces
     labelList onSurface(mesh.nPoints(), 0);
     DynamicList<label> projecting;
+    fixingPatch_.setSize(mesh.boundaryMesh().size(), false);
     for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
     {
+        fixingPatch_[pf.patch().index()] = pf.fixesValue();
         if (projectsOntoSurface(pf))
         {
             // (its projectMode as it writes it: the class keeps it private)
@@ -359,6 +361,7 @@ Foam::boundaryConstraints::boundaryConstraints
     boundaryPoints_(bc.boundaryPoints_),
     cyclicPoints_(bc.cyclicPoints_),
     nCyclicGlobal_(bc.nCyclicGlobal_),
+    fixingPatch_(bc.fixingPatch_),
     nSurfaceGlobal_(0),
     onSurface_(bc.onSurface_),
     curvedSlipCos_(bc.curvedSlipCos_)

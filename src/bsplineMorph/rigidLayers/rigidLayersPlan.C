@@ -354,13 +354,13 @@ void Foam::rigidLayers::rigidAtBase
 
 void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
 {
-    // Each point's patch: -1 on a listed one, else the first wall that
-    // holds it on any rank (labelMax: none)
+    // Each point's patch: -1 on a listed one, else the first wall whose
+    // condition fixes it that holds it on any rank (labelMax: none)
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     labelList patchOf(mesh_.nPoints(), labelMax);
     forAllReverse(pbm, patchi)
     {
-        if (isWall(pbm[patchi]))
+        if (isWall(pbm[patchi]) && (patchIDs_.found(patchi) || bc.fixesPatch(patchi)))
         {
             const label k = patchIDs_.found(patchi) ? -1 : patchi;
             for (const label pointi : pbm[patchi].meshPoints())
