@@ -567,6 +567,23 @@ TEST_CASE("rigidLayers: a foot on another wall gets half on the bisector, none o
 }
 
 
+TEST_CASE("rigidLayers: a rotation's twist about a normal is its turn about it", "[foam][rigidLayers]")
+{
+    const vector n = normalised(vector(0.3, -0.2, 1));
+    const vector m = normalised(n ^ vector(1, 0, 0));
+    const tensor Rn = Ra(n, 0.8);
+    const tensor Rm = Ra(m, 0.5);
+    // (the swing about m applied after the turn about n: the twist is the
+    // turn; a swing alone has none; a wall at rest stays exactly at rest)
+    CHECK(mag(rigidLayers::twist(Rn, n) - Rn) < 1e-15);
+    CHECK(mag(rigidLayers::twist(Rm & Rn, n) - Rn) < 1e-15);
+    CHECK(mag(rigidLayers::twist(Rm, n) - tensor::I) < 1e-15);
+    CHECK(rigidLayers::twist(tensor::I, n) == tensor::I);
+    // A swing of half a turn about m leaves no twist to find: the identity
+    CHECK(rigidLayers::twist(Ra(m, constant::mathematical::pi), n) == tensor::I);
+}
+
+
 TEST_CASE("rigidLayers: the fitted rotation is the rotation of a rigid map", "[foam][rigidLayers]")
 {
     // M = R S with S symmetric positive definite: the polar factor is R

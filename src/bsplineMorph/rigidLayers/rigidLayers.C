@@ -75,6 +75,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     planned_(false),
     nSmooth_(0),
     anySurfaceShell_(false),
+    anyPair_(false),
     transformsFinal_(false),
     baseRigidValid_(false)
 {
@@ -407,6 +408,32 @@ void Foam::rigidLayers::addControls
         plan(points0);
         warnFixedInZone(bc);
     }
+    // The points of sliding listed walls within innerDistance of another
+    // listed wall, held by this rank as wall points: they turn with the
+    // other wall's foot (turnWithPairs(); below, they keep to its layers)
+    {
+        const boolList& fixed = bc.fixed();
+        const List<pointConstraint>& slides = bc.slides();
+        DynamicList<label> pairWall;
+        DynamicList<vector> normals;
+        forAll(zonePair_, i)
+        {
+            const label pointi = zonePoints_[i];
+            const label wi = zoneFoot_[i];
+            if
+            (
+                zonePair_[i] >= 0 && magSqr(zoneArm_[i]) == 0 && !fixed[pointi]
+             && slides[pointi].first() == 1 && wi < wallPoints_.size()
+             && wallPoints_[wi] == pointi
+            )
+            {
+                pairWall.append(i);
+                normals.append(normalised(slides[pointi].second()));
+            }
+        }
+        pairWall_.transfer(pairWall);
+        pairWallNormal_.transfer(normals);
+    }
     if (shift && !baseRigidValid_)
     {
         rigidAtBase(points0, *shift);
@@ -549,8 +576,27 @@ void Foam::rigidLayers::fitMovedWalls
 {
     fitRotations(points0, from0);
     footDisplacement_ = vectorField(from0, wallPoints_);
+    if (anyPair_)
+    {
+        turnWithPairs();
+    }
     mapPtr_->distribute(rotation_);
     mapPtr_->distribute(footDisplacement_);
+}
+
+
+void Foam::rigidLayers::turnWithPairs()
+{
+    // (the other wall's feet may be on other ranks: the rotations in the
+    // feet's compact numbering first)
+    tensorField compact(rotation_);
+    mapPtr_->distribute(compact);
+    forAll(pairWall_, k)
+    {
+        const label i = pairWall_[k];
+        rotation_[zoneFoot_[i]] =
+            twist(compact[pairFoot_[zonePair_[i]]], pairWallNormal_[k]);
+    }
 }
 
 

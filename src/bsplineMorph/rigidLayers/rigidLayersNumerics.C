@@ -16,6 +16,7 @@ License
 \*---------------------------------------------------------------------------*/
 
 #include "rigidLayers.H"
+#include "quaternion.H"
 
 #include <cmath>
 
@@ -70,6 +71,15 @@ Foam::scalar Foam::rigidLayers::pairShare
     const scalar dSqr = d*d;
     const scalar sum = dSqr + d2*d2;
     return sum > 0 ? r*r*(1 + 2*t)*dSqr/sum : 0.5;
+}
+
+
+Foam::tensor Foam::rigidLayers::twist(const tensor& R, const vector& n)
+{
+    const quaternion q(R);
+    const quaternion t(q.w(), (q.v() & n)*n);
+    const scalar m = mag(t);
+    return m > SMALL ? quaternion(t.w()/m, t.v()/m).R() : tensor::I;
 }
 
 

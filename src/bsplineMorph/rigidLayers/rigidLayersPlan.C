@@ -259,6 +259,7 @@ void Foam::rigidLayers::plan(const pointField& points0)
         footCandidates(points0, wallIndex, pointPatch, nNearest)
     );
     findFeet(points0, cand, nNearest);
+    anyPair_ = returnReduce(pairFoot_.size() > 0, orOp<bool>());
     findOutermost();
     // The feet in compact numbering: this rank's wall points, then the other
     // ranks' that are feet here (the nearest feet, then the other walls')
