@@ -324,7 +324,8 @@ void Foam::rigidLayers::plan(const pointField& points0)
     if (nPaired)
     {
         Info<< "rigidLayers: " << nPaired << " of those points are near two"
-            << " listed walls (where they meet) and blend the two walls' rigid"
+            << " listed walls (where they meet or pass near each other) and"
+            << " blend the two walls' rigid"
             << " motions; " << nOwnedGlobal(owned, pairedOnWall)
             << " of them lie on a wall, within innerDistance of the other:"
             << " where their wall slides, they keep to the other wall's layers"
