@@ -202,6 +202,7 @@ Foam::boundaryConstraints::boundaryConstraints
     surfaceConditionPoints_ = onAnyRank(mesh, onSurface);
     onSurface_.resize(mesh.nPoints());
     onSurface_.set(surfaceConditionPoints_);
+    projectedByCondition_ = onSurface_;
     nSurfaceGlobal_ = returnReduce(surfaceConditionPoints_.size(), sumOp<label>());
     if (Pstream::parRun())
     {
@@ -364,6 +365,7 @@ Foam::boundaryConstraints::boundaryConstraints
     fixingPatch_(bc.fixingPatch_),
     nSurfaceGlobal_(0),
     onSurface_(bc.onSurface_),
+    projectedByCondition_(bc.projectedByCondition_),
     curvedSlipCos_(bc.curvedSlipCos_)
 {
     for (const label pointi : bc.projected_)

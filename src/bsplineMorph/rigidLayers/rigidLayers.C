@@ -270,7 +270,10 @@ void Foam::rigidLayers::addControls
     forAll(wallPoints_, i)
     {
         footFixed[i] = fixed[wallPoints_[i]];
-        footOnSurface[i] = bc.onSurface(wallPoints_[i]);
+        // (by their conditions: the sliding walls' points that follow
+        // another wall's projection below are marked from the first step
+        // on, and a restart's first step must see what any other sees)
+        footOnSurface[i] = bc.projectedByCondition(wallPoints_[i]);
         footSlide[i] = bc.slides()[wallPoints_[i]];
     }
     mapPtr_->distribute(rotation_);
