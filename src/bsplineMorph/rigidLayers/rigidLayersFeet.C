@@ -56,14 +56,27 @@ namespace
         return s;
     }
 
-    //- An octree of the points (held by reference), its box grown by margin
+    //- The candidates' positions: the first n of them
+    template<class Candidate>
+    pointField positionsOf(const std::vector<Candidate>& cand, const label n)
+    {
+        pointField points(n);
+        forAll(points, c)
+        {
+            points[c] = cand[c].x;
+        }
+        return points;
+    }
+
+    //- An octree of the points (held by reference), their box bb grown by
+    //  margin
     autoPtr<indexedOctree<treeDataPoint>> pointTree
     (
         const pointField& points,
+        const treeBoundBox& bb,
         const scalar margin
     )
     {
-        const treeBoundBox bb(points);
         return autoPtr<indexedOctree<treeDataPoint>>::New
         (
             treeDataPoint(points),
@@ -135,7 +148,6 @@ namespace
     };
 }
 }
-
 
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
@@ -266,15 +278,11 @@ void Foam::rigidLayers::findFeet
     {
         return;
     }
-    pointField candPoints(nNearest);
-    forAll(candPoints, c)
-    {
-        candPoints[c] = cand[c].x;
-    }
+    const pointField candPoints(positionsOf(cand, nNearest));
     const treeBoundBox candBox(candPoints);
     const autoPtr<indexedOctree<treeDataPoint>> treePtr
     (
-        pointTree(candPoints, outerDistance_)
+        pointTree(candPoints, candBox, outerDistance_)
     );
     const indexedOctree<treeDataPoint>& tree = *treePtr;
 
@@ -295,17 +303,13 @@ void Foam::rigidLayers::findFeet
     PtrList<indexedOctree<treeDataPoint>> patchTree(nPatches);
     for (label k = 0; k < nPatches; ++k)
     {
-        patchPoints[k].setSize(label(patchCand[k].size()));
-        forAll(patchPoints[k], c)
-        {
-            patchPoints[k][c] = patchCand[k][c].x;
-        }
+        patchPoints[k] = positionsOf(patchCand[k], label(patchCand[k].size()));
         if (patchPoints[k].empty())
         {
             continue;
         }
         patchBox[k] = treeBoundBox(patchPoints[k]);
-        patchTree.set(k, pointTree(patchPoints[k], outerDistance_));
+        patchTree.set(k, pointTree(patchPoints[k], patchBox[k], outerDistance_));
     }
 
     DynamicList<label> zone, feet, zonePair, pairFeet;
