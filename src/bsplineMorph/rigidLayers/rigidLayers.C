@@ -198,7 +198,7 @@ void Foam::rigidLayers::addControls
 {
     if (!planned_)
     {
-        plan(points0);
+        plan(points0, bc);
         warnFixedInZone(bc);
     }
     // The points of sliding listed walls within innerDistance of another
@@ -417,7 +417,9 @@ void Foam::rigidLayers::apply
 {
     if (!planned_)
     {
-        plan(points0);
+        FatalErrorInFunction
+            << "rigidLayers::apply() before addControls(), which plans the"
+            << " zone" << exit(FatalError);
     }
     // (the displacement from points0: a rebased morph's is from its base)
     const tmp<vectorField> tfrom0

@@ -42,7 +42,11 @@ bool Foam::rigidLayers::isWall(const polyPatch& pp)
 }
 
 
-void Foam::rigidLayers::findWallPoints(const pointField& points0)
+void Foam::rigidLayers::findWallPoints
+(
+    const pointField& points0,
+    const labelList& pointPatch
+)
 {
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
     // The wall points, and where each listed patch's points are among them
@@ -129,16 +133,23 @@ void Foam::rigidLayers::findWallPoints(const pointField& points0)
     nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
     smoothCoeffs_ = powerCoeffs(nSmooth_, powerTolerance);
 
-    // Each listed face's points as indices into wallPoints_
+    // Each listed face's points of its own patch (pointPatch) as indices
+    // into wallPoints_: a point where two listed walls meet takes its
+    // rotation from its own patch's faces alone, and the smoothing keeps
+    // to each patch, so that a wall that moves as a solid keeps its own
+    // rotation up to where it meets a deforming one
     DynamicList<label> start(1, 0);
     DynamicList<label> facePoints;
-    for (const label patchi : patchIDs_)
+    forAll(patchIDs_, k)
     {
-        for (const face& f : pbm[patchi])
+        for (const face& f : pbm[patchIDs_[k]])
         {
             for (const label pointi : f)
             {
-                facePoints.append(wallOf[pointi]);
+                if (pointPatch[pointi] == k)
+                {
+                    facePoints.append(wallOf[pointi]);
+                }
             }
             start.append(facePoints.size());
         }
@@ -237,21 +248,56 @@ void Foam::rigidLayers::findOutermost()
 }
 
 
-void Foam::rigidLayers::plan(const pointField& points0)
+void Foam::rigidLayers::plan
+(
+    const pointField& points0,
+    const boundaryConstraints& bc
+)
 {
-    findWallPoints(points0);
-    // Each wall point's patch: the first listed one that holds it on any
-    // rank (the same on every decomposition)
+    // Each wall point's own patch: the first listed one that holds it on
+    // any rank (the same on every decomposition), those whose conditions
+    // say more of their points' motion first: fixing it, then projecting
+    // onto a surface, then sliding on planes. Where a moved body meets a
+    // wall it slides on, the points they share move with the body and take
+    // its rotation (the wall's rotation about its normal there is the
+    // interpolated field's, or the body's layers')
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
-    labelList pointPatch(mesh_.nPoints(), labelMax);
-    forAllReverse(patchIDs_, k)
+    const auto kind = [&](const label patchi)
     {
-        for (const label pointi : pbm[patchIDs_[k]].meshPoints())
+        return
+            bc.fixesPatch(patchi) ? 0
+          : bc.projectingPatches().found(patchi) ? 1
+          : 2;
+    };
+    labelList order(patchIDs_.size());
+    label nOrdered = 0;
+    for (label rank = 0; rank < 3; ++rank)
+    {
+        forAll(patchIDs_, k)
         {
-            pointPatch[pointi] = k;
+            if (kind(patchIDs_[k]) == rank)
+            {
+                order[nOrdered++] = k;
+            }
+        }
+    }
+    labelList pointPatch(mesh_.nPoints(), labelMax);
+    forAllReverse(order, r)
+    {
+        for (const label pointi : pbm[patchIDs_[order[r]]].meshPoints())
+        {
+            pointPatch[pointi] = r;
         }
     }
     syncTools::syncPointList(mesh_, pointPatch, minEqOp<label>(), labelMax);
+    for (label& k : pointPatch)
+    {
+        if (k != labelMax)
+        {
+            k = order[k];
+        }
+    }
+    findWallPoints(points0, pointPatch);
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;
     const std::vector<footCandidate> cand

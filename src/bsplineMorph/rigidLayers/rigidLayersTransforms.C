@@ -178,7 +178,9 @@ void Foam::rigidLayers::fitRotations
             {
                 sum += in[wallFacePoints_[i]];
             }
-            faceMeans_[facei] = sum/scalar(end - start);
+            // (a face none of whose points are its patch's own: no point
+            // reads its mean)
+            faceMeans_[facei] = end > start ? sum/scalar(end - start) : sum;
         }
         out.setSize(nWall);
         for (label wi = 0; wi < nWall; ++wi)
