@@ -45,7 +45,8 @@ bool Foam::rigidLayers::isWall(const polyPatch& pp)
 void Foam::rigidLayers::findWallPoints
 (
     const pointField& points0,
-    const labelList& pointPatch
+    const labelList& pointPatch,
+    const labelList& kind
 )
 {
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
@@ -133,11 +134,14 @@ void Foam::rigidLayers::findWallPoints
     nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
     smoothCoeffs_ = powerCoeffs(nSmooth_, powerTolerance);
 
-    // Each listed face's points of its own patch (pointPatch) as indices
-    // into wallPoints_: a point where two listed walls meet takes its
-    // rotation from its own patch's faces alone, and the smoothing keeps
-    // to each patch, so that a wall that moves as a solid keeps its own
-    // rotation up to where it meets a deforming one
+    // Each listed face's points whose own patch (pointPatch) is of the
+    // face's patch's kind, as indices into wallPoints_: where listed walls
+    // of different kinds meet (a moved body on a wall it slides on), a
+    // point takes its rotation from the faces of its own patch's kind
+    // alone, and the smoothing keeps to them, so that the body keeps its
+    // rotation up to the wall; walls of one kind (a deforming wall in
+    // several patches) are smoothed across as one wall, so that their
+    // rotations do not jump where they meet
     DynamicList<label> start(1, 0);
     DynamicList<label> facePoints;
     forAll(patchIDs_, k)
@@ -146,7 +150,7 @@ void Foam::rigidLayers::findWallPoints
         {
             for (const label pointi : f)
             {
-                if (pointPatch[pointi] == k)
+                if (kind[pointPatch[pointi]] == kind[k])
                 {
                     facePoints.append(wallOf[pointi]);
                 }
@@ -254,28 +258,31 @@ void Foam::rigidLayers::plan
     const boundaryConstraints& bc
 )
 {
-    // Each wall point's own patch: the first listed one that holds it on
-    // any rank (the same on every decomposition), those whose conditions
-    // say more of their points' motion first: fixing it, then projecting
-    // onto a surface, then sliding on planes. Where a moved body meets a
-    // wall it slides on, the points they share move with the body and take
-    // its rotation (the wall's rotation about its normal there is the
-    // interpolated field's, or the body's layers')
+    // The listed patches' kinds, by how much of their points' motion their
+    // conditions say: 0 fixing it, 1 projecting it onto a surface, 2
+    // sliding on planes. Each wall point's own patch: the first listed one
+    // that holds it on any rank (the same on every decomposition) of the
+    // lowest kind. Where a moved body meets a wall it slides on, the points
+    // they share move with the body and take its rotation (the wall's
+    // rotation about its normal there is the interpolated field's, or the
+    // body's layers')
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
-    const auto kind = [&](const label patchi)
+    labelList kind(patchIDs_.size());
+    forAll(patchIDs_, k)
     {
-        return
+        const label patchi = patchIDs_[k];
+        kind[k] =
             bc.fixesPatch(patchi) ? 0
           : bc.projectingPatches().found(patchi) ? 1
           : 2;
-    };
+    }
     labelList order(patchIDs_.size());
     label nOrdered = 0;
     for (label rank = 0; rank < 3; ++rank)
     {
         forAll(patchIDs_, k)
         {
-            if (kind(patchIDs_[k]) == rank)
+            if (kind[k] == rank)
             {
                 order[nOrdered++] = k;
             }
@@ -297,7 +304,7 @@ void Foam::rigidLayers::plan
             k = order[k];
         }
     }
-    findWallPoints(points0, pointPatch);
+    findWallPoints(points0, pointPatch, kind);
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;
     const std::vector<footCandidate> cand
