@@ -131,7 +131,11 @@ void Foam::rigidLayers::findWallPoints
     edgeSum = returnReduce(edgeSum, sumOp<scalar>());
     nEdges = returnReduce(nEdges, sumOp<label>());
     const scalar rings = nEdges && edgeSum > 0 ? innerDistance_*nEdges/edgeSum : 0;
-    nSmooth_ = min(label(std::ceil(rings*rings)), maxSmooth);
+    // (rounded up, but within 1e-9 above a whole number that number: the
+    // sum's last bits differ from one decomposition to another, and an
+    // innerDistance of a whole number of edges, as often chosen, would
+    // round to either)
+    nSmooth_ = min(label(std::ceil(rings*rings*(1 - 1e-9))), maxSmooth);
     smoothCoeffs_ = powerCoeffs(nSmooth_, powerTolerance);
 
     // Each listed face's points whose own patch (pointPatch) is of the
