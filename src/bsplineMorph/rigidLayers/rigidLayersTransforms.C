@@ -178,8 +178,8 @@ void Foam::rigidLayers::fitRotations
             {
                 sum += in[wallFacePoints_[i]];
             }
-            // (a face none of whose points are its patch's own: no point
-            // reads its mean)
+            // (a face none of whose points belong to its patch's kind: no
+            // point reads its mean)
             faceMeans_[facei] = end > start ? sum/scalar(end - start) : sum;
         }
         out.setSize(nWall);
