@@ -214,18 +214,18 @@ void Foam::boundaryConstraints::readSlidingPatch(const pointPatchVectorField& pf
         // line, fixed): a patch spanning several planes (the faces of a box)
         // constrains its edge points to the line where they meet. Averaged
         // point normals would not: they tilt at edges and differ between the
-        // ranks that share a point. Where the patch bends smoothly (a curved
-        // wall), the mean of its faces' normals at the point, summed over the
-        // ranks that hold it: the point slides in that plane, as OpenFOAM's
-        // slip slides along point normals (leaving a wall of radius R by
-        // about d^2/2R for a slide d)
+        // ranks that share a point. Where the patch is smooth (a curved wall,
+        // or a flat one), the mean of its faces' normals at the point, summed
+        // over the ranks that hold it: the point slides in that plane, as
+        // OpenFOAM's slip slides along point normals (leaving a wall of
+        // radius R by about d^2/2R for a slide d)
         const polyPatch& patch = refCast<const facePointPatch>(pp).patch();
         const vectorField& nf = slipNormals_[pp.index()];
         const labelListList& pointFaces = patch.pointFaces();
         const vectorField& mean = slipMean_[pp.index()];
         forAll(pointFaces, lp)
         {
-            if (mean.size() && mean[lp] != vector::zero)
+            if (mean[lp] != vector::zero)
             {
                 applyNormal(meshPoints[lp], mean[lp]);
                 continue;
@@ -355,33 +355,37 @@ Foam::vectorField Foam::boundaryConstraints::curvedSlip
     List<scalar> count;
     const sharedPoints shared(pMesh_(), patch.meshPoints());
     sumFaceNormals(patch, shared, nf0, sum, count);
-    // Bent smoothly: |sum| of unit normals within (cos curvedSlipAngle, 1)
-    // of their count (two faces: within twice the angle of each other;
-    // coplanar ones to rounding, 1e-9, keep their own normals)
+    // Smooth: |sum| of unit normals at least cos curvedSlipAngle of their
+    // count (two faces: within twice the angle of each other). Bent: not
+    // coplanar to rounding, 1e-9: those slide in the base's mean plane (a
+    // rebased morph's curved wall), the coplanar ones in points0's, which
+    // stays put (a wall a little off flat, snapped: each face's own plane
+    // would leave the point on the first face's of a rank, which differs
+    // between decompositions)
     const scalar smooth = curvedSlipCos_;
+    vectorField mean(patch.nPoints(), Zero);
     boolList bentAt(patch.nPoints(), false);
     bool bent = false;
     forAll(sum, lp)
     {
         const scalar m = mag(sum[lp]);
-        bentAt[lp] = m >= smooth*count[lp] && m < (1 - 1e-9)*count[lp];
-        bent = bent || bentAt[lp];
+        if (m >= smooth*count[lp])
+        {
+            mean[lp] = sum[lp]/m;
+            bentAt[lp] = m < (1 - 1e-9)*count[lp];
+            bent = bent || bentAt[lp];
+        }
     }
     reduce(bent, orOp<bool>());
-    if (!bent)
-    {
-        return vectorField();
-    }
-    if (&nf != &nf0)
+    if (bent && &nf != &nf0)
     {
         sumFaceNormals(patch, shared, nf, sum, count);
-    }
-    vectorField mean(patch.nPoints(), Zero);
-    forAll(sum, lp)
-    {
-        if (bentAt[lp])
+        forAll(sum, lp)
         {
-            mean[lp] = sum[lp]/mag(sum[lp]);
+            if (bentAt[lp])
+            {
+                mean[lp] = sum[lp]/mag(sum[lp]);
+            }
         }
     }
     return mean;
