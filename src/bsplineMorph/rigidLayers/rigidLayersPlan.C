@@ -280,24 +280,14 @@ void Foam::rigidLayers::plan
           : bc.projectingPatches().found(patchi) ? 1
           : 2;
     }
-    labelList order(patchIDs_.size());
-    label nOrdered = 0;
-    for (label rank = 0; rank < 3; ++rank)
-    {
-        forAll(patchIDs_, k)
-        {
-            if (kind[k] == rank)
-            {
-                order[nOrdered++] = k;
-            }
-        }
-    }
+    // (the least of kind*nListed + k over the patches holding the point)
+    const label nListed = patchIDs_.size();
     labelList pointPatch(mesh_.nPoints(), labelMax);
-    forAllReverse(order, r)
+    forAll(patchIDs_, k)
     {
-        for (const label pointi : pbm[patchIDs_[order[r]]].meshPoints())
+        for (const label pointi : pbm[patchIDs_[k]].meshPoints())
         {
-            pointPatch[pointi] = r;
+            pointPatch[pointi] = min(pointPatch[pointi], kind[k]*nListed + k);
         }
     }
     syncTools::syncPointList(mesh_, pointPatch, minEqOp<label>(), labelMax);
@@ -305,7 +295,7 @@ void Foam::rigidLayers::plan
     {
         if (k != labelMax)
         {
-            k = order[k];
+            k %= nListed;
         }
     }
     findWallPoints(points0, pointPatch, kind);
