@@ -43,6 +43,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     nSmooth_(0),
     anySurfaceShell_(false),
     anyPair_(false),
+    fixedInZoneToWarn_(false),
     transformsFinal_(false),
     baseRigidValid_(false)
 {
@@ -199,7 +200,7 @@ void Foam::rigidLayers::addControls
     if (!planned_)
     {
         plan(points0, bc);
-        warnFixedInZone(bc);
+        findFixedInZone(bc);
     }
     // The points of sliding listed walls within innerDistance of another
     // listed wall (below: they keep to its layers), and among them this
@@ -430,6 +431,10 @@ void Foam::rigidLayers::apply
     if (!transformsFinal_)
     {
         fitMovedWalls(points0, from0);
+    }
+    if (fixedInZoneToWarn_)
+    {
+        warnFixedInZone(from0, frame);
     }
 
     forAll(zonePoints_, i)

@@ -25,6 +25,7 @@ License
 #include "HashOps.H"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 // The plan of the rigid layers, once per topology: the walls' points, the
@@ -401,7 +402,7 @@ void Foam::rigidLayers::rigidAtBase
 }
 
 
-void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
+void Foam::rigidLayers::findFixedInZone(const boundaryConstraints& bc)
 {
     // Each point's patch: -1 on a listed one, else the first wall whose
     // condition fixes it that holds it on any rank (labelMax: none)
@@ -420,10 +421,7 @@ void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
     }
     syncTools::syncPointList(mesh_, patchOf, minEqOp<label>(), labelMax);
 
-    const boolList owned(ownedPoints(mesh_));
-    wordHashSet names;
-    label n = 0;
-    scalar nearest = GREAT;
+    DynamicList<label> zonei, patches;
     forAll(zonePoints_, i)
     {
         const label pointi = zonePoints_[i];
@@ -434,27 +432,75 @@ void Foam::rigidLayers::warnFixedInZone(const boundaryConstraints& bc) const
          && bc.fixed()[pointi]
         )
         {
-            names.insert(pbm[patchi].name());
+            zonei.append(i);
+            patches.append(patchi);
+        }
+    }
+    fixedInZone_.transfer(zonei);
+    fixedInZonePatch_.transfer(patches);
+    fixedInZoneToWarn_ = returnReduce(fixedInZone_.size() > 0, orOp<bool>());
+}
+
+
+void Foam::rigidLayers::warnFixedInZone
+(
+    const vectorField& from0,
+    const solutionFrame& frame
+)
+{
+    // How far each such point's prescribed displacement departs from the
+    // rigid motion of the layers about it, against its distance from the
+    // wall: the shear of the cells between
+    scalarField shear(fixedInZone_.size());
+    scalar maxShear = 0;
+    forAll(fixedInZone_, k)
+    {
+        const label i = fixedInZone_[k];
+        const label pointi = zonePoints_[i];
+        shear[k] =
+            mag(frame.inFrame(pointi, zoneRigid(i) - from0[pointi]))
+           /max(mag(zoneArm_[i]), VSMALL);
+        maxShear = max(maxShear, shear[k]);
+    }
+    // (a shear of this size is one of some 0.6 deg: below it, as where a
+    // pushed side moves along a listed wall it meets, no warning)
+    const scalar warnShear = 0.01;
+    if (returnReduce(maxShear, maxOp<scalar>()) < warnShear)
+    {
+        return;
+    }
+    fixedInZoneToWarn_ = false;
+
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    const boolList owned(ownedPoints(mesh_));
+    wordHashSet names;
+    label n = 0;
+    scalar nearest = GREAT;
+    forAll(fixedInZone_, k)
+    {
+        if (shear[k] >= warnShear)
+        {
+            const label i = fixedInZone_[k];
+            names.insert(pbm[fixedInZonePatch_[k]].name());
             nearest = min(nearest, mag(zoneArm_[i]));
-            n += owned[pointi];
+            n += owned[zonePoints_[i]];
         }
     }
     reduce(n, sumOp<label>());
     reduce(nearest, minOp<scalar>());
+    reduce(maxShear, maxOp<scalar>());
     Pstream::combineGather(names, HashSetOps::plusEqOp<word>());
     Pstream::combineScatter(names);
-    if (n)
-    {
-        IOWarningInFunction(dict_)
-            << n << " points of " << flatOutput(names.sortedToc())
-            << ", whose boundary conditions fix their displacement, lie"
-            << " within innerDistance " << innerDistance_ << " of the walls"
-            << " (the nearest " << nearest << " from them): they keep that"
-            << " displacement while the points about them move rigidly with"
-            << " the walls, which shears the cells between. List those"
-            << " patches too, or make innerDistance less than " << nearest
-            << endl;
-    }
+    IOWarningInFunction(dict_)
+        << n << " points of " << flatOutput(names.sortedToc())
+        << ", whose boundary conditions fix their displacement, lie"
+        << " within innerDistance " << innerDistance_ << " of the walls"
+        << " (the nearest " << nearest << " from them): at time "
+        << mesh_.time().timeName() << " that displacement departs from the"
+        << " rigid motion of the layers about them by up to "
+        << std::round(1000*maxShear)/10 << "% of their distance from the"
+        << " walls, which shears the cells between. List those patches"
+        << " too, or make innerDistance less than " << nearest << endl;
 }
 
 
