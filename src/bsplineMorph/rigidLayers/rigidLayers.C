@@ -218,7 +218,7 @@ void Foam::rigidLayers::addControls
             if
             (
                 zonePair_[i] < 0 || magSqr(zoneArm_[i]) > 0 || fixed[pointi]
-             || slides[pointi].first() == 0
+             || slides[pointi].first() == 0 || !pairFollows_.test(zonePair_[i])
             )
             {
                 continue;

@@ -274,6 +274,7 @@ void Foam::rigidLayers::findFeet
     pairFoot_.clear();
     pairArm_.clear();
     pairShare_.clear();
+    pairPatch_.clear();
     if (nNearest == 0)
     {
         return;
@@ -312,7 +313,7 @@ void Foam::rigidLayers::findFeet
         patchTree.set(k, pointTree(patchPoints[k], patchBox[k], outerDistance_));
     }
 
-    DynamicList<label> zone, feet, zonePair, pairFeet;
+    DynamicList<label> zone, feet, zonePair, pairFeet, pairPatches;
     DynamicList<scalar> weights, shares;
     DynamicList<vector> arms, pairArms;
     const scalar outerSqr = sqr(outerDistance_);
@@ -375,6 +376,7 @@ void Foam::rigidLayers::findFeet
             zonePair.resize(zone.size(), -1);
             zonePair.last() = pairFeet.size();
             pairFeet.append(c.globalIndex);
+            pairPatches.append(pairPatch);
             pairArms.append(x - c.x);
             shares.append(pairShare(d, std::sqrt(pairSqr), width));
         }
@@ -391,6 +393,7 @@ void Foam::rigidLayers::findFeet
     pairFoot_.transfer(pairFeet);
     pairArm_.transfer(pairArms);
     pairShare_.transfer(shares);
+    pairPatch_.transfer(pairPatches);
     // (swept at every step)
     onHugePages(zonePoints_);
     onHugePages(zoneFoot_);

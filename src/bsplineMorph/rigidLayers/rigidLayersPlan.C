@@ -325,6 +325,16 @@ void Foam::rigidLayers::plan
     }
     footPatch_ = labelList(UIndirectList<label>(pointPatch, wallPoints_));
     mapPtr_->distribute(footPatch_);
+    pairFollows_.reset();
+    pairFollows_.resize(pairFoot_.size());
+    forAll(zonePair_, i)
+    {
+        const label p = zonePair_[i];
+        if (p >= 0)
+        {
+            pairFollows_.set(p, kind[pairPatch_[p]] <= kind[footPatch_[zoneFoot_[i]]]);
+        }
+    }
     planned_ = true;
     const wordList patchNames(pbm.names(), patchIDs_);
     // (each point counted once, however many ranks hold it)
