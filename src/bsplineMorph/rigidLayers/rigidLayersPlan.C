@@ -438,8 +438,7 @@ void Foam::rigidLayers::findFixedInZone(const boundaryConstraints& bc)
         const label patchi = patchOf[pointi];
         if
         (
-            zoneWeight_[i] == 1 && patchi >= 0 && patchi != labelMax
-         && bc.fixed()[pointi]
+            patchi >= 0 && patchi != labelMax && bc.fixed()[pointi]
         )
         {
             zonei.append(i);
@@ -459,8 +458,9 @@ void Foam::rigidLayers::warnFixedInZone
 )
 {
     // How far each such point's prescribed displacement departs from the
-    // rigid motion of the layers about it, against its distance from the
-    // wall: the shear of the cells between
+    // rigid motion of the layers about it (in the blend: the weight's share
+    // of it), against its distance from the wall: the shear of the cells
+    // between
     scalarField shear(fixedInZone_.size());
     scalar maxShear = 0;
     forAll(fixedInZone_, k)
@@ -468,7 +468,7 @@ void Foam::rigidLayers::warnFixedInZone
         const label i = fixedInZone_[k];
         const label pointi = zonePoints_[i];
         shear[k] =
-            mag(frame.inFrame(pointi, zoneRigid(i) - from0[pointi]))
+            zoneWeight_[i]*mag(frame.inFrame(pointi, zoneRigid(i) - from0[pointi]))
            /max(mag(zoneArm_[i]), VSMALL);
         maxShear = max(maxShear, shear[k]);
     }
@@ -504,13 +504,15 @@ void Foam::rigidLayers::warnFixedInZone
     IOWarningInFunction(dict_)
         << n << " points of " << flatOutput(names.sortedToc())
         << ", whose boundary conditions fix their displacement, lie"
-        << " within innerDistance " << innerDistance_ << " of the walls"
-        << " (the nearest " << nearest << " from them): at time "
+        << " within outerDistance " << outerDistance_ << " of the walls (the"
+        << " nearest " << nearest << " from them; innerDistance "
+        << innerDistance_ << "): at time "
         << mesh_.time().timeName() << " that displacement departs from the"
-        << " rigid motion of the layers about them by up to "
+        << " motion the layers give the points about them by up to "
         << std::round(1000*maxShear)/10 << "% of their distance from the"
         << " walls, which shears the cells between. List those patches"
-        << " too, or make innerDistance less than " << nearest << endl;
+        << " too, or keep the layers off them: outerDistance (and"
+        << " innerDistance) less than " << nearest << endl;
 }
 
 
