@@ -98,24 +98,37 @@ void Foam::interpolatingMotionSolver::refuseInverted
         << r.nFolded << " folded: positive volume but a face pyramid"
         << " wrongly oriented against the cell centre, as checkMesh counts"
         << " them; cells (their points' means) within " << r.where << ")";
-    const label nBlend = rigidLayersPtr_ ? rigidLayersPtr_->nCellsInBlend(r.cells) : 0;
-    if (nBlend)
+    const labelPair nLayers =
+        rigidLayersPtr_ ? rigidLayersPtr_->nCellsInBlend(r.cells) : labelPair(0, 0);
+    if (nLayers.first())
     {
-        what<< "; " << nBlend << " of them have a point in the rigidLayers"
-            << " blend (between innerDistance and outerDistance), which"
-            << " strains most under a crease of a deforming wall: a"
-            << " narrower blend (outerDistance nearer innerDistance)"
-            << " strains it less";
+        what<< "; " << nLayers.first() << " of them have a point in the"
+            << " rigidLayers blend (between innerDistance and outerDistance),"
+            << " which takes up the difference between the layers' rigid"
+            << " motion and the interpolated field: another outerDistance"
+            << " spreads it otherwise (under a crease of a deforming wall a"
+            << " narrower blend (outerDistance nearer innerDistance) strains"
+            << " it less)";
+    }
+    if (nLayers.second())
+    {
+        what<< "; " << nLayers.second() << " of them have a point near two"
+            << " listed walls, where the walls' rigid motions blend: walls"
+            << " that move against each other need room between their rigid"
+            << " layers (a smaller innerDistance)";
     }
     if (invertedCellsFatal_)
     {
+        // (without rebase the morph is from the initial mesh whatever the
+        // steps: smaller ones change nothing)
         FatalErrorInFunction
             << "The prescribed motion"
             << (rebase_ ? ", morphed from the last step's mesh (rebase on)," : "")
             << " inverts " << what.str().c_str()
-            << "; the mesh is not moved."
-            << " Smaller motion steps, other " << type() << "Coeffs"
-            << " settings, " << (rebase_ ? "" : "rebase on (to morph from the last step's mesh), ")
+            << "; the mesh is not moved. "
+            << (rebase_ ? "Smaller motion steps, other " : "Other ")
+            << type() << "Coeffs settings, "
+            << (rebase_ ? "" : "rebase on (to morph from the last step's mesh), ")
             << "or invertedCells warn (to continue anyway) are"
             << " the options" << exit(FatalError);
     }

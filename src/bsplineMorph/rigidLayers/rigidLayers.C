@@ -477,27 +477,32 @@ void Foam::rigidLayers::markRigid(bitSet& rigid) const
 }
 
 
-Foam::label Foam::rigidLayers::nCellsInBlend(const labelList& cells) const
+Foam::labelPair Foam::rigidLayers::nCellsInBlend(const labelList& cells) const
 {
-    bitSet blend(mesh_.nPoints());
+    bitSet blend(mesh_.nPoints()), paired(mesh_.nPoints());
     forAll(zonePoints_, i)
     {
-        if (zoneWeight_[i] < 1)
-        {
-            blend.set(zonePoints_[i]);
-        }
+        blend.set(zonePoints_[i], zoneWeight_[i] < 1);
+        paired.set(zonePoints_[i], zonePair_.size() && zonePair_[i] >= 0);
     }
-    label n = 0;
+    labelPair n(0, 0);
     for (const label celli : cells)
     {
         const labelList cellPoints = mesh_.cells()[celli].labels(mesh_.faces());
-        n += std::any_of
-        (
-            cellPoints.begin(), cellPoints.end(),
-            [&](const label pointi) { return blend.test(pointi); }
-        );
+        const auto any = [&](const bitSet& set)
+        {
+            return std::any_of
+            (
+                cellPoints.begin(), cellPoints.end(),
+                [&](const label pointi) { return set.test(pointi); }
+            );
+        };
+        n.first() += any(blend);
+        n.second() += any(paired);
     }
-    return returnReduce(n, sumOp<label>());
+    reduce(n.first(), sumOp<label>());
+    reduce(n.second(), sumOp<label>());
+    return n;
 }
 
 
