@@ -475,7 +475,8 @@ void Foam::rigidLayers::warnFixedInZone
     // (a shear of this size is one of some 0.6 deg: below it, as where a
     // pushed side moves along a listed wall it meets, no warning)
     const scalar warnShear = 0.01;
-    if (returnReduce(maxShear, maxOp<scalar>()) < warnShear)
+    reduce(maxShear, maxOp<scalar>());
+    if (maxShear < warnShear)
     {
         return;
     }
@@ -498,7 +499,6 @@ void Foam::rigidLayers::warnFixedInZone
     }
     reduce(n, sumOp<label>());
     reduce(nearest, minOp<scalar>());
-    reduce(maxShear, maxOp<scalar>());
     Pstream::combineGather(names, HashSetOps::plusEqOp<word>());
     Pstream::combineScatter(names);
     IOWarningInFunction(dict_)
