@@ -62,6 +62,11 @@ def pointsAt(case, time):
     """The points of case at time (a name or a number as OpenFOAM writes it; "constant": the undeformed ones)"""
     return readPoints("%s/%s/polyMesh/points" % (case, time) if time != "constant" else "%s/constant/polyMesh/points" % case)
 
+def largestDifference(pa, pb):
+    """The largest coordinate difference between two lists of points (over the
+    points both have)"""
+    return max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
+
 def comparePoints(a, b, time):
     """Case b's points at time against case a's: dict(nA, nB, diff: the largest
     coordinate difference (over the points both have), size: the largest
@@ -69,8 +74,7 @@ def comparePoints(a, b, time):
     pa, pb = pointsAt(a, time), pointsAt(b, time)
     p0 = pointsAt(a, "constant")
     size = max(max(p[d] for p in p0) - min(p[d] for p in p0) for d in range(3))
-    diff = max(max(abs(x - y) for x, y in zip(p, q)) for p, q in zip(pa, pb))
-    return dict(nA=len(pa), nB=len(pb), diff=diff, size=size)
+    return dict(nA=len(pa), nB=len(pb), diff=largestDifference(pa, pb), size=size)
 
 # ---------------------------------------------------------------- tables
 

@@ -261,7 +261,8 @@ void Foam::rigidLayers::findFeet
 (
     const pointField& points0,
     const std::vector<footCandidate>& cand,
-    const label nNearest
+    const label nNearest,
+    const labelList& kind
 )
 {
     // The candidates in an octree: each point's nearest one within
@@ -274,7 +275,7 @@ void Foam::rigidLayers::findFeet
     pairFoot_.clear();
     pairArm_.clear();
     pairShare_.clear();
-    pairPatch_.clear();
+    pairFollows_.clear();
     if (nNearest == 0)
     {
         return;
@@ -313,7 +314,8 @@ void Foam::rigidLayers::findFeet
         patchTree.set(k, pointTree(patchPoints[k], patchBox[k], outerDistance_));
     }
 
-    DynamicList<label> zone, feet, zonePair, pairFeet, pairPatches;
+    DynamicList<label> zone, feet, zonePair, pairFeet;
+    DynamicList<bool> follows;
     DynamicList<scalar> weights, shares;
     DynamicList<vector> arms, pairArms;
     const scalar outerSqr = sqr(outerDistance_);
@@ -376,7 +378,8 @@ void Foam::rigidLayers::findFeet
             zonePair.resize(zone.size(), -1);
             zonePair.last() = pairFeet.size();
             pairFeet.append(c.globalIndex);
-            pairPatches.append(pairPatch);
+            // (a point's first candidate's patch is its own patch)
+            follows.append(kind[pairPatch] <= kind[cand[best].patch]);
             pairArms.append(x - c.x);
             shares.append(pairShare(d, std::sqrt(pairSqr), width));
         }
@@ -393,7 +396,7 @@ void Foam::rigidLayers::findFeet
     pairFoot_.transfer(pairFeet);
     pairArm_.transfer(pairArms);
     pairShare_.transfer(shares);
-    pairPatch_.transfer(pairPatches);
+    pairFollows_ = bitSet(follows);
     // (swept at every step)
     onHugePages(zonePoints_);
     onHugePages(zoneFoot_);

@@ -306,7 +306,7 @@ void Foam::rigidLayers::plan
     (
         footCandidates(points0, wallIndex, pointPatch, nNearest)
     );
-    findFeet(points0, cand, nNearest);
+    findFeet(points0, cand, nNearest, kind);
     anyPair_ = returnReduce(pairFoot_.size() > 0, orOp<bool>());
     findOutermost();
     // The feet in compact numbering: this rank's wall points, then the other
@@ -325,16 +325,6 @@ void Foam::rigidLayers::plan
     }
     footPatch_ = labelList(UIndirectList<label>(pointPatch, wallPoints_));
     mapPtr_->distribute(footPatch_);
-    pairFollows_.reset();
-    pairFollows_.resize(pairFoot_.size());
-    forAll(zonePair_, i)
-    {
-        const label p = zonePair_[i];
-        if (p >= 0)
-        {
-            pairFollows_.set(p, kind[pairPatch_[p]] <= kind[footPatch_[zoneFoot_[i]]]);
-        }
-    }
     planned_ = true;
     const wordList patchNames(pbm.names(), patchIDs_);
     // (each point counted once, however many ranks hold it)
