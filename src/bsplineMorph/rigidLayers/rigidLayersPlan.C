@@ -299,6 +299,11 @@ void Foam::rigidLayers::plan
             k %= nListed;
         }
     }
+    projects_.setSize(kind.size());
+    forAll(kind, k)
+    {
+        projects_[k] = kind[k] == 1;
+    }
     findWallPoints(points0, pointPatch, kind);
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;

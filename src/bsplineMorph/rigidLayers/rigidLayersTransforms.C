@@ -46,6 +46,28 @@ namespace
         }
         return area;
     }
+
+    //- The normal at vertex v of a face of the given points, weighted as
+    //  Max (1999): the cross product of its two edges there over the
+    //  product of their squared lengths. Summed over a point's faces it is
+    //  exactly the normal of a sphere through the point and its neighbours,
+    //  however unevenly they are spaced (and of a cylinder where they lie
+    //  around the point and along the axis; Max, Weights for computing
+    //  vertex normals from facet normals, J. Graphics Tools 4(2), 1999)
+    vector cornerNormal
+    (
+        const face& f,
+        const label v,
+        const pointField& p0,
+        const vectorField* u
+    )
+    {
+        const auto at = [&](const label p) { return u ? p0[p] + (*u)[p] : p0[p]; };
+        const point x = at(f[v]);
+        const vector prev = at(f.prevLabel(v)) - x;
+        const vector next = at(f.nextLabel(v)) - x;
+        return (next ^ prev)/(magSqr(prev)*magSqr(next) + VSMALL);
+    }
 }
 }
 
@@ -70,6 +92,11 @@ void Foam::rigidLayers::fitRotations
     rotation_.setSize(nWall);
     rotation_ = Zero;
     tensorField patchSum(patchIDs_.size(), Zero);
+    // (and at the points of the projected walls their normals, from points0
+    // and moved)
+    const bool anyProjects = projects_.found(true);
+    vectorField normal0(anyProjects ? nWall : 0, Zero);
+    vectorField normal1(anyProjects ? nWall : 0, Zero);
     label wallFacei = 0;
     forAll(patchIDs_, k)
     {
@@ -140,6 +167,16 @@ void Foam::rigidLayers::fitRotations
             {
                 rotation_[wallFacePoints_[i]] += M;
             }
+            // (the face's points of its patch's kind are in face order)
+            for (label v = 0, i = start; projects_[k] && i < end; ++v)
+            {
+                if (wallPoints_[wallFacePoints_[i]] == f[v])
+                {
+                    normal0[wallFacePoints_[i]] += cornerNormal(f, v, points0, nullptr);
+                    normal1[wallFacePoints_[i]] += cornerNormal(f, v, points0, &displacement);
+                    ++i;
+                }
+            }
             patchSum[k] += M;
         }
     }
@@ -208,6 +245,32 @@ void Foam::rigidLayers::fitRotations
     {
         knownMatrix_ = matrices;
         knownRotation_ = rotation_;
+    }
+    // A wall projected onto a surface keeps its shape while its points
+    // slide over it, so that its normals are known where the fitted and
+    // smoothed rotation (which takes in the shear of an uneven slide)
+    // turns them less or more: each point's rotation turned on by the least
+    // rotation that carries its rotated normal onto the moved normal, so
+    // that its layers leave the moved wall straight (the fitted turn about
+    // the normal kept)
+    if (anyProjects)
+    {
+        wallSum_->sum(normal0);
+        wallSum_->sum(normal1);
+        forAll(normal0, wi)
+        {
+            const scalar m0 = mag(normal0[wi]);
+            const scalar m1 = mag(normal1[wi]);
+            if (m0 > VSMALL && m1 > VSMALL)
+            {
+                const vector n = (rotation_[wi] & normal0[wi])/m0;
+                const vector n1 = normal1[wi]/m1;
+                if ((n & n1) > 0)
+                {
+                    rotation_[wi] = rotationTensor(n, n1) & rotation_[wi];
+                }
+            }
+        }
     }
 }
 
