@@ -172,7 +172,7 @@ Foam::boundaryConstraints::boundaryConstraints
 
     // The points that conditions project onto surfaces
     labelList onSurface(mesh.nPoints(), 0);
-    DynamicList<label> projecting;
+    DynamicList<label> projecting, smooth;
     fixingPatch_.setSize(mesh.boundaryMesh().size(), false);
     for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
     {
@@ -196,9 +196,28 @@ Foam::boundaryConstraints::boundaryConstraints
             }
             projecting.append(pf.patch().index());
             UIndirectList<label>(onSurface, pf.patch().meshPoints()) = 1;
+            // (by the surfaces' types, as written in full or short)
+            const wordHashSet smoothTypes
+            {
+                "searchableSphere", "sphere", "searchableCylinder", "cylinder",
+                "searchablePlane", "plane"
+            };
+            bool allSmooth = true;
+            const dictionary* geometry = written.findDict("geometry");
+            for (const entry& e : geometry ? *geometry : dictionary::null)
+            {
+                allSmooth =
+                    allSmooth && e.isDict()
+                 && smoothTypes.found(e.dict().lookupOrDefault<word>("type", word::null));
+            }
+            if (geometry && allSmooth)
+            {
+                smooth.append(pf.patch().index());
+            }
         }
     }
     projectingPatches_.transfer(projecting);
+    smoothProjectingPatches_.transfer(smooth);
     surfaceConditionPoints_ = onAnyRank(mesh, onSurface);
     onSurface_.resize(mesh.nPoints());
     onSurface_.set(surfaceConditionPoints_);

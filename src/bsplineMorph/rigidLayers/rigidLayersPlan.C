@@ -299,10 +299,10 @@ void Foam::rigidLayers::plan
             k %= nListed;
         }
     }
-    projects_.setSize(kind.size());
+    smoothSurface_.setSize(kind.size());
     forAll(kind, k)
     {
-        projects_[k] = kind[k] == 1;
+        smoothSurface_[k] = bc.smoothProjectingPatches().found(patchIDs_[k]);
     }
     findWallPoints(points0, pointPatch, kind);
     const globalIndex wallIndex(wallPoints_.size());

@@ -53,7 +53,9 @@ namespace
     //  exactly the normal of a sphere through the point and its neighbours,
     //  however unevenly they are spaced (and of a cylinder where they lie
     //  around the point and along the axis; Max, Weights for computing
-    //  vertex normals from facet normals, J. Graphics Tools 4(2), 1999)
+    //  vertex normals from facet normals, J. Graphics Tools 4(2), 1999;
+    //  on faces whose two edges at the vertex differ in length by less than
+    //  a hundred times)
     vector cornerNormal
     (
         const face& f,
@@ -66,7 +68,11 @@ namespace
         const point x = at(f[v]);
         const vector prev = at(f.prevLabel(v)) - x;
         const vector next = at(f.nextLabel(v)) - x;
-        return (next ^ prev)/(magSqr(prev)*magSqr(next) + VSMALL);
+        // (an edge shorter than a hundredth of the other weighs as one that
+        // long: a near-degenerate face's round-off does not set the normal)
+        const scalar p2 = magSqr(prev), n2 = magSqr(next);
+        const scalar least = 1e-4*max(p2, n2);
+        return (next ^ prev)/(max(p2, least)*max(n2, least) + VSMALL);
     }
 }
 }
@@ -92,9 +98,9 @@ void Foam::rigidLayers::fitRotations
     rotation_.setSize(nWall);
     rotation_ = Zero;
     tensorField patchSum(patchIDs_.size(), Zero);
-    // (and at the points of the projected walls their normals, from points0
-    // and moved)
-    const bool anyProjects = projects_.found(true);
+    // (and at the points of the walls projected onto smooth surfaces their
+    // normals, from points0 and moved)
+    const bool anyProjects = smoothSurface_.found(true);
     vectorField normal0(anyProjects ? nWall : 0, Zero);
     vectorField normal1(anyProjects ? nWall : 0, Zero);
     label wallFacei = 0;
@@ -168,7 +174,7 @@ void Foam::rigidLayers::fitRotations
                 rotation_[wallFacePoints_[i]] += M;
             }
             // (the face's points of its patch's kind are in face order)
-            for (label v = 0, i = start; projects_[k] && i < end; ++v)
+            for (label v = 0, i = start; smoothSurface_[k] && i < end; ++v)
             {
                 if (wallPoints_[wallFacePoints_[i]] == f[v])
                 {
@@ -246,13 +252,14 @@ void Foam::rigidLayers::fitRotations
         knownMatrix_ = matrices;
         knownRotation_ = rotation_;
     }
-    // A wall projected onto a surface keeps its shape while its points
-    // slide over it, so that its normals are known where the fitted and
-    // smoothed rotation (which takes in the shear of an uneven slide)
+    // A wall projected onto smooth surfaces keeps its shape while its
+    // points slide over it, so that its normals are known where the fitted
+    // and smoothed rotation (which takes in the shear of an uneven slide)
     // turns them less or more: each point's rotation turned on by the least
     // rotation that carries its rotated normal onto the moved normal, so
     // that its layers leave the moved wall straight (the fitted turn about
-    // the normal kept)
+    // the normal kept). (Not over facets or edges: there the normal turns
+    // at once, and the smoothed fit keeps the layers from doing so.)
     if (anyProjects)
     {
         wallSum_->sum(normal0);
