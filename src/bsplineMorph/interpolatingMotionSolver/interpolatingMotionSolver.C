@@ -99,7 +99,7 @@ void Foam::interpolatingMotionSolver::refuseInverted
         << " wrongly oriented against the cell centre, as checkMesh counts"
         << " them; cells (their points' means) within " << r.where << ")";
     const labelPair nLayers =
-        rigidLayersPtr_ ? rigidLayersPtr_->nCellsInBlend(r.cells) : labelPair(0, 0);
+        rigidLayersPtr_ ? rigidLayersPtr_->nCellsInBlendAndPairs(r.cells) : labelPair(0, 0);
     if (nLayers.first())
     {
         what<< "; " << nLayers.first() << " of them have a point in the"

@@ -477,7 +477,7 @@ void Foam::rigidLayers::markRigid(bitSet& rigid) const
 }
 
 
-Foam::labelPair Foam::rigidLayers::nCellsInBlend(const labelList& cells) const
+Foam::labelPair Foam::rigidLayers::nCellsInBlendAndPairs(const labelList& cells) const
 {
     bitSet blend(mesh_.nPoints()), paired(mesh_.nPoints());
     forAll(zonePoints_, i)

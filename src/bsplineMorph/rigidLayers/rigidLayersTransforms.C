@@ -174,7 +174,7 @@ void Foam::rigidLayers::fitRotations
                 rotation_[wallFacePoints_[i]] += M;
             }
             // (the face's points of its patch's kind are in face order)
-            for (label v = 0, i = start; smoothSurface_[k] && i < end; ++v)
+            for (label v = 0, i = start; smoothSurface_[k] && i < end && v < f.size(); ++v)
             {
                 if (wallPoints_[wallFacePoints_[i]] == f[v])
                 {
