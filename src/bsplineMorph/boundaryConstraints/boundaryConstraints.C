@@ -196,21 +196,22 @@ Foam::boundaryConstraints::boundaryConstraints
             }
             projecting.append(pf.patch().index());
             UIndirectList<label>(onSurface, pf.patch().meshPoints()) = 1;
-            // (by the surfaces' types, as written in full or short)
+            // (one surface, by its type as written in full or short: several
+            // meet in edges)
             const wordHashSet smoothTypes
             {
                 "searchableSphere", "sphere", "searchableCylinder", "cylinder",
                 "searchablePlane", "plane"
             };
-            bool allSmooth = true;
             const dictionary* geometry = written.findDict("geometry");
-            for (const entry& e : geometry ? *geometry : dictionary::null)
-            {
-                allSmooth =
-                    allSmooth && e.isDict()
-                 && smoothTypes.found(e.dict().lookupOrDefault<word>("type", word::null));
-            }
-            if (geometry && allSmooth)
+            if
+            (
+                geometry && geometry->size() == 1 && geometry->first()->isDict()
+             && smoothTypes.found
+                (
+                    geometry->first()->dict().lookupOrDefault<word>("type", word::null)
+                )
+            )
             {
                 smooth.append(pf.patch().index());
             }

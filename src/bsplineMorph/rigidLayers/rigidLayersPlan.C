@@ -305,6 +305,32 @@ void Foam::rigidLayers::plan
         smoothSurface_[k] = bc.smoothProjectingPatches().found(patchIDs_[k]);
     }
     findWallPoints(points0, pointPatch, kind);
+    // The wall points whose normal is their smooth surface's: their own
+    // patch projects onto one, and none of their faces (on any rank) is of
+    // a patch that does not (where such patches meet, the normal from their
+    // faces turns abruptly)
+    smoothWall_.clear();
+    if (smoothSurface_.found(true))
+    {
+        scalarField rough(wallPoints_.size(), Zero);
+        label facei = 0;
+        forAll(patchIDs_, k)
+        {
+            for (label n = pbm[patchIDs_[k]].size(); n > 0; --n, ++facei)
+            {
+                for (label i = wallFaceStart_[facei]; i < wallFaceStart_[facei + 1]; ++i)
+                {
+                    rough[wallFacePoints_[i]] += !smoothSurface_[k];
+                }
+            }
+        }
+        wallSum_->sum(rough);
+        smoothWall_.resize(wallPoints_.size());
+        forAll(wallPoints_, wi)
+        {
+            smoothWall_.set(wi, smoothSurface_[pointPatch[wallPoints_[wi]]] && rough[wi] == 0);
+        }
+    }
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;
     const std::vector<footCandidate> cand

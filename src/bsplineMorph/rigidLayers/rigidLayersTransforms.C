@@ -255,16 +255,16 @@ void Foam::rigidLayers::fitRotations
     // A wall projected onto smooth surfaces keeps its shape while its
     // points slide over it, so that its normals are known where the fitted
     // and smoothed rotation (which takes in the shear of an uneven slide)
-    // turns them less or more: each point's rotation turned on by the least
+    // turns them less or more: each point's rotation turned further by the least
     // rotation that carries its rotated normal onto the moved normal, so
     // that its layers leave the moved wall straight (the fitted turn about
     // the normal kept). (Not over facets or edges: there the normal turns
-    // at once, and the smoothed fit keeps the layers from doing so.)
+    // abruptly, and the smoothed fit keeps the layers from doing so.)
     if (anyProjects)
     {
         wallSum_->sum(normal0);
         wallSum_->sum(normal1);
-        forAll(normal0, wi)
+        for (const label wi : smoothWall_)
         {
             const scalar m0 = mag(normal0[wi]);
             const scalar m1 = mag(normal1[wi]);
