@@ -26,8 +26,6 @@ License
 #include "processorPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
 #include "unitConversion.H"
-#include "OStringStream.H"
-#include "IStringStream.H"
 
 #include <algorithm>
 #include <cmath>
@@ -36,23 +34,6 @@ License
 
 namespace
 {
-    //- The points flagged (non-zero) on any rank that holds them, ascending
-    //  (flag is synced in place)
-    Foam::labelList onAnyRank(const Foam::polyMesh& mesh, Foam::labelList& flag)
-    {
-        using namespace Foam;
-        syncTools::syncPointList(mesh, flag, maxEqOp<label>(), label(0));
-        DynamicList<label> points;
-        forAll(flag, pointi)
-        {
-            if (flag[pointi])
-            {
-                points.append(pointi);
-            }
-        }
-        return labelList(std::move(points));
-    }
-
     //- The cyclic coupling of a patch: the patch itself (a cyclic, not
     //  split over ranks), the cyclic a processorCyclic is part of, else none
     const Foam::cyclicPolyPatch* cyclicCoupling(const Foam::polyPatch& pp)
@@ -117,6 +98,25 @@ Foam::label Foam::nOwnedGlobal(const boolList& owned)
 
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
+Foam::labelList Foam::boundaryConstraints::onAnyRank
+(
+    const polyMesh& mesh,
+    labelList& flag
+)
+{
+    syncTools::syncPointList(mesh, flag, maxEqOp<label>(), label(0));
+    DynamicList<label> points;
+    forAll(flag, pointi)
+    {
+        if (flag[pointi])
+        {
+            points.append(pointi);
+        }
+    }
+    return labelList(std::move(points));
+}
+
+
 Foam::boundaryConstraints::boundaryConstraints
 (
     const pointVectorField& pointDisplacement,
@@ -170,78 +170,12 @@ Foam::boundaryConstraints::boundaryConstraints
     cyclicPoints_ = onAnyRank(mesh, joined);
     nCyclicGlobal_ = returnReduce(cyclicPoints_.size(), sumOp<label>());
 
-    // The points that conditions project onto surfaces
-    labelList onSurface(mesh.nPoints(), 0);
-    DynamicList<label> projecting, smooth;
     fixingPatch_.setSize(mesh.boundaryMesh().size(), false);
     for (const pointPatchVectorField& pf : pointDisplacement.boundaryField())
     {
         fixingPatch_[pf.patch().index()] = pf.fixesValue();
-        if (projectsOntoSurface(pf))
-        {
-            // (its projectMode as it writes it: the class keeps it private)
-            OStringStream os;
-            pf.write(os);
-            const dictionary written((IStringStream(os.str()))());
-            if (written.lookupOrDefault<word>("projectMode", word::null) == "pointNormal")
-            {
-                FatalErrorInFunction
-                    << pointDisplacement.objectPath() << ", boundaryField "
-                    << pf.patch().name() << ": " << pf.type() << " with"
-                    << " projectMode pointNormal projects along point normals,"
-                    << " which a rank forms from its own faces only: the points"
-                    << " would differ between decompositions. Use projectMode"
-                    << " nearest or fixedNormal. The mesh is not moved"
-                    << exit(FatalError);
-            }
-            projecting.append(pf.patch().index());
-            UIndirectList<label>(onSurface, pf.patch().meshPoints()) = 1;
-            // (one surface, by its type as written in full or short: several
-            // meet in edges)
-            const wordHashSet smoothTypes
-            {
-                "searchableSphere", "sphere", "searchableCylinder", "cylinder",
-                "searchablePlane", "plane"
-            };
-            const dictionary* geometry = written.findDict("geometry");
-            if
-            (
-                geometry && geometry->size() == 1 && geometry->first()->isDict()
-             && smoothTypes.found
-                (
-                    geometry->first()->dict().lookupOrDefault<word>("type", word::null)
-                )
-            )
-            {
-                smooth.append(pf.patch().index());
-            }
-        }
     }
-    projectingPatches_.transfer(projecting);
-    smoothProjectingPatches_.transfer(smooth);
-    surfaceConditionPoints_ = onAnyRank(mesh, onSurface);
-    onSurface_.resize(mesh.nPoints());
-    onSurface_.set(surfaceConditionPoints_);
-    projectedByCondition_ = onSurface_;
-    nSurfaceGlobal_ = returnReduce(surfaceConditionPoints_.size(), sumOp<label>());
-    if (Pstream::parRun())
-    {
-        // Per projecting patch: its points on any rank, their copies through
-        // processor patches, and those this rank's faces of it hold
-        surfacePoints_.setSize(projectingPatches_.size());
-        projectsHere_.setSize(projectingPatches_.size());
-        surfaceSync_.resize(projectingPatches_.size());
-        forAll(projectingPatches_, k)
-        {
-            const labelList& meshPoints = mesh.boundaryMesh()[projectingPatches_[k]].meshPoints();
-            projectsHere_[k].resize(mesh.nPoints());
-            projectsHere_[k].set(meshPoints);
-            labelList flag(mesh.nPoints(), 0);
-            UIndirectList<label>(flag, meshPoints) = 1;
-            surfacePoints_[k] = onAnyRank(mesh, flag);
-            surfaceSync_[k] = std::make_shared<const sharedPoints>(mesh, surfacePoints_[k], true);
-        }
-    }
+    findProjectingPatches(pointDisplacement);
     if (nCyclicGlobal_ > 0)
     {
         // (the patches in order: the last that fixes a point wins; over the
@@ -515,45 +449,6 @@ void Foam::boundaryConstraints::matchCyclic(vectorField& displacement) const
 }
 
 
-void Foam::boundaryConstraints::syncProjected
-(
-    const label k,
-    vectorField& displacement
-) const
-{
-    // A rank that holds a point of the projecting patch but none of the
-    // patch's faces about it (a point of a floor beside a projected
-    // cylinder) did not project it: it takes the projection of a rank that
-    // did (the point's owner's, else the first rank in order that did; all
-    // that did computed the same, from the values the patches before this
-    // one left, which these syncs keep the same on every rank)
-    if (surfaceSync_.empty())
-    {
-        return;
-    }
-    const vector none(vector::max);
-    const bitSet& here = projectsHere_[k];
-    surfaceWork_.setSize(displacement.size());
-    for (const label pointi : surfacePoints_[k])
-    {
-        surfaceWork_[pointi] = here.test(pointi) ? displacement[pointi] : none;
-    }
-    surfaceSync_[k]->combineMesh
-    (
-        surfaceWork_,
-        [&none](vector& x, const vector& y) { if (x == none) x = y; },
-        none
-    );
-    for (const label pointi : surfacePoints_[k])
-    {
-        if (!here.test(pointi) && surfaceWork_[pointi] != none)
-        {
-            displacement[pointi] = surfaceWork_[pointi];
-        }
-    }
-}
-
-
 void Foam::boundaryConstraints::addPoints(const labelList& points)
 {
     bitSet all(pMesh_().nPoints());
@@ -656,23 +551,6 @@ void Foam::boundaryConstraints::slideOne
     else
     {
         d = slide_[pointi].constrainDisplacement(d);
-    }
-}
-
-
-void Foam::boundaryConstraints::slideBeforeProjection(vectorField& displacement) const
-{
-    // (the fit meets its control points to its tolerance only: a point of
-    // a projected wall that also lies on a symmetry or slip plane would keep
-    // the fit's error across that plane, which the projection onto the
-    // surface does not remove)
-    const solutionFrame& frame = *frame_;
-    for (const label pointi : surfaceConditionPoints_)
-    {
-        if (!fixed_[pointi] && slide_[pointi].first() > 0)
-        {
-            slideOne(frame, pointi, displacement[pointi]);
-        }
     }
 }
 
