@@ -98,8 +98,8 @@ void Foam::rigidLayers::fitRotations
     rotation_.setSize(nWall);
     rotation_ = Zero;
     tensorField patchSum(patchIDs_.size(), Zero);
-    // (and at the points of the walls projected onto smooth surfaces their
-    // normals, from points0 and moved)
+    // (and at the points of the walls projected onto one smooth surface
+    // their normals, from points0 and moved)
     const bool anyProjects = smoothSurface_.found(true);
     vectorField normal0(anyProjects ? nWall : 0, Zero);
     vectorField normal1(anyProjects ? nWall : 0, Zero);
@@ -252,14 +252,15 @@ void Foam::rigidLayers::fitRotations
         knownMatrix_ = matrices;
         knownRotation_ = rotation_;
     }
-    // A wall projected onto smooth surfaces keeps its shape while its
+    // A wall projected onto one smooth surface keeps its shape while its
     // points slide over it, so that its normals are known where the fitted
     // and smoothed rotation (which takes in the shear of an uneven slide)
-    // turns them less or more: each point's rotation turned further by the least
-    // rotation that carries its rotated normal onto the moved normal, so
-    // that its layers leave the moved wall straight (the fitted turn about
-    // the normal kept). (Not over facets or edges: there the normal turns
-    // abruptly, and the smoothed fit keeps the layers from doing so.)
+    // turns them less or more: each point's rotation turned further by the
+    // least rotation that carries its rotated normal onto the moved normal,
+    // so that its layers leave the moved wall straight (the fitted turn
+    // about the normal kept). (Not over facets or edges, smoothWall_: there
+    // the normal turns abruptly, and the smoothed fit keeps the layers from
+    // doing so.)
     if (anyProjects)
     {
         wallSum_->sum(normal0);
