@@ -310,6 +310,7 @@ void Foam::rigidLayers::plan
     // a patch that does not (where such patches meet, the normal from their
     // faces turns abruptly)
     smoothWall_.clear();
+    wallNormal0_.clear();
     if (smoothSurface_.found(true))
     {
         scalarField rough(wallPoints_.size(), Zero);
@@ -330,6 +331,7 @@ void Foam::rigidLayers::plan
         {
             smoothWall_.set(wi, smoothSurface_[pointPatch[wallPoints_[wi]]] && rough[wi] == 0);
         }
+        wallNormal0_ = smoothWallNormals(points0, nullptr);
     }
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;

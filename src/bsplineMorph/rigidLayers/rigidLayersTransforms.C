@@ -98,11 +98,6 @@ void Foam::rigidLayers::fitRotations
     rotation_.setSize(nWall);
     rotation_ = Zero;
     tensorField patchSum(patchIDs_.size(), Zero);
-    // (and at the points of the walls projected onto one smooth surface
-    // their normals, from points0 and moved)
-    const bool anyProjects = smoothSurface_.found(true);
-    vectorField normal0(anyProjects ? nWall : 0, Zero);
-    vectorField normal1(anyProjects ? nWall : 0, Zero);
     label wallFacei = 0;
     forAll(patchIDs_, k)
     {
@@ -172,16 +167,6 @@ void Foam::rigidLayers::fitRotations
             for (label i = start; i < end; ++i)
             {
                 rotation_[wallFacePoints_[i]] += M;
-            }
-            // (the face's points of its patch's kind are in face order)
-            for (label v = 0, i = start; smoothSurface_[k] && i < end && v < f.size(); ++v)
-            {
-                if (wallPoints_[wallFacePoints_[i]] == f[v])
-                {
-                    normal0[wallFacePoints_[i]] += cornerNormal(f, v, points0, nullptr);
-                    normal1[wallFacePoints_[i]] += cornerNormal(f, v, points0, &displacement);
-                    ++i;
-                }
             }
             patchSum[k] += M;
         }
@@ -260,18 +245,18 @@ void Foam::rigidLayers::fitRotations
     // so that its layers leave the moved wall straight (the fitted turn
     // about the normal kept). (Not over facets or edges, smoothWall_: there
     // the normal turns abruptly, and the smoothed fit keeps the layers from
-    // doing so.)
-    if (anyProjects)
+    // doing so.) Not in a fit from the known faces alone: a projected
+    // wall's points are known after the fit only.
+    if (!known && smoothSurface_.found(true))
     {
-        wallSum_->sum(normal0);
-        wallSum_->sum(normal1);
+        const vectorField normal1(smoothWallNormals(points0, &displacement));
         for (const label wi : smoothWall_)
         {
-            const scalar m0 = mag(normal0[wi]);
+            const scalar m0 = mag(wallNormal0_[wi]);
             const scalar m1 = mag(normal1[wi]);
             if (m0 > VSMALL && m1 > VSMALL)
             {
-                const vector n = (rotation_[wi] & normal0[wi])/m0;
+                const vector n = (rotation_[wi] & wallNormal0_[wi])/m0;
                 const vector n1 = normal1[wi]/m1;
                 if ((n & n1) > 0)
                 {
@@ -280,6 +265,37 @@ void Foam::rigidLayers::fitRotations
             }
         }
     }
+}
+
+
+Foam::vectorField Foam::rigidLayers::smoothWallNormals
+(
+    const pointField& points0,
+    const vectorField* displacement
+) const
+{
+    vectorField normal(wallPoints_.size(), Zero);
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    label wallFacei = 0;
+    forAll(patchIDs_, k)
+    {
+        for (const face& f : pbm[patchIDs_[k]])
+        {
+            const label start = wallFaceStart_[wallFacei];
+            const label end = wallFaceStart_[++wallFacei];
+            // (the face's points of its patch's kind are in face order)
+            for (label v = 0, i = start; smoothSurface_[k] && i < end && v < f.size(); ++v)
+            {
+                if (wallPoints_[wallFacePoints_[i]] == f[v])
+                {
+                    normal[wallFacePoints_[i]] += cornerNormal(f, v, points0, displacement);
+                    ++i;
+                }
+            }
+        }
+    }
+    wallSum_->sum(normal);
+    return normal;
 }
 
 
