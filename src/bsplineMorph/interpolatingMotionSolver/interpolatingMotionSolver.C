@@ -115,7 +115,9 @@ void Foam::interpolatingMotionSolver::refuseInverted
         what<< "; " << nLayers.second() << " of them have a point near two"
             << " listed walls, where the walls' rigid motions blend: walls"
             << " that move against each other need room between their rigid"
-            << " layers (a smaller innerDistance)";
+            << " layers (a smaller innerDistance; where they face each other"
+            << " across a gap, an outerDistance of at most half of it: the"
+            << " plan warns of such gaps)";
     }
     if (invertedCellsFatal_)
     {

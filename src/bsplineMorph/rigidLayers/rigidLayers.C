@@ -43,6 +43,7 @@ Foam::rigidLayers::rigidLayers(const polyMesh& mesh, const dictionary& dict)
     nSmooth_(0),
     anySurfaceShell_(false),
     anyPair_(false),
+    facingWarned_(false),
     fixedInZoneToWarn_(false),
     transformsFinal_(false),
     baseRigidValid_(false)

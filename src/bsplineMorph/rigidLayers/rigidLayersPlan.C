@@ -23,6 +23,9 @@ License
 #include "globalIndex.H"
 #include "bitSet.H"
 #include "HashOps.H"
+#include "Map.H"
+#include "OStringStream.H"
+#include "unitConversion.H"
 
 #include <algorithm>
 #include <cmath>
@@ -412,6 +415,72 @@ void Foam::rigidLayers::plan
             << " where their wall slides, they keep to the other wall's layers"
             << endl;
     }
+    warnFacingGaps();
+}
+
+
+void Foam::rigidLayers::warnFacingGaps()
+{
+    if (facingWarned_ || !anyPair_)
+    {
+        return;
+    }
+    // Per pair of listed walls (k < l: key k*n + l) the narrowest gap
+    const label n = patchIDs_.size();
+    const scalar facing = std::cos(degToRad(150.0));
+    Map<scalar> gaps;
+    forAll(zonePair_, i)
+    {
+        const label p = zonePair_[i];
+        if (p < 0)
+        {
+            continue;
+        }
+        const vector& a = zoneArm_[i];
+        const vector& b = pairArm_[p];
+        const scalar gap = mag(a) + mag(b);
+        // (a gap of twice outerDistance, to round-off, leaves its middle to
+        // the interpolated field)
+        if
+        (
+            gap < (2 - 1e-9)*outerDistance_
+         && mag(a) > 0 && mag(b) > 0 && (a & b) < facing*mag(a)*mag(b)
+        )
+        {
+            const label k = footPatch_[zoneFoot_[i]];
+            const label l = footPatch_[pairFoot_[p]];
+            const label key = min(k, l)*n + max(k, l);
+            gaps.set(key, min(gap, gaps.lookup(key, GREAT)));
+        }
+    }
+    Pstream::mapCombineGather(gaps, minEqOp<scalar>());
+    Pstream::mapCombineScatter(gaps);
+    if (gaps.empty())
+    {
+        return;
+    }
+    facingWarned_ = true;
+    const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    OStringStream which;
+    scalar narrowest = GREAT;
+    for (const label key : gaps.sortedToc())
+    {
+        which<< (which.str().empty() ? "" : ", ")
+            << pbm[patchIDs_[key/n]].name() << " and "
+            << pbm[patchIDs_[key % n]].name() << " " << gaps[key] << " apart";
+        narrowest = min(narrowest, gaps[key]);
+    }
+    IOWarningInFunction(dict_)
+        << "Listed walls face each other across gaps narrower than twice"
+        << " outerDistance (" << 2*outerDistance_ << "): "
+        << which.str().c_str() << ". Where they move against each other"
+        << " (pushed, sheared or turned), the middle of such a gap moves in"
+        << " part with their rigid motions, blended, rather than with the"
+        << " interpolated field, and the cells between their rigid layers"
+        << " take up the whole relative motion and fold early: an"
+        << " outerDistance of at most half the gap (" << 0.5*narrowest
+        << ") and an innerDistance that covers only the prism layers give"
+        << " those cells the most room" << endl;
 }
 
 
