@@ -116,8 +116,7 @@ void Foam::interpolatingMotionSolver::refuseInverted
             << " listed walls, where the walls' rigid motions blend: walls"
             << " that move against each other need room between their rigid"
             << " layers (a smaller innerDistance; where they face each other"
-            << " across a gap, an outerDistance of at most half of it: the"
-            << " plan warns of such gaps)";
+            << " across a gap, an outerDistance of half of it)";
     }
     if (invertedCellsFatal_)
     {

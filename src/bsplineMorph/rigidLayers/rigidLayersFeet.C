@@ -157,6 +157,7 @@ std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
     const pointField& points0,
     const globalIndex& wallIndex,
     const labelList& pointPatch,
+    const vectorField& wallNormal,
     label& nNearest
 ) const
 {
@@ -165,8 +166,15 @@ std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
     // within outerDistance of this rank's points, each with the first
     // listed patch that holds it (the nearest foot's candidates); then the
     // same again for the other listed patches that hold it (where walls
-    // meet: candidates of the feet on another wall only)
-    const scalar outer = outerDistance_;
+    // meet: candidates of the feet on another wall only); with two listed
+    // patches or more those within twice outerDistance (a point's nearest
+    // foot on another wall, for the gaps between walls that face each
+    // other: findFeet())
+    const scalar reach = (patchIDs_.size() > 1 ? 2 : 1)*outerDistance_;
+    const auto normalOf = [&](const label wi)
+    {
+        return wallNormal.size() ? wallNormal[wi] : vector::zero;
+    };
     List<boundBox> rankBox(Pstream::nProcs());
     rankBox[myProc] = boundBox(points0, false);
     Pstream::gatherList(rankBox);
@@ -203,7 +211,10 @@ std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
     {
         (c < nFirst ? cand : others).push_back
         (
-            {wallIndex.toGlobal(wall[c]), points0[wallPoints_[wall[c]]], patch[c], true}
+            {
+                wallIndex.toGlobal(wall[c]), points0[wallPoints_[wall[c]]],
+                patch[c], true, normalOf(wall[c])
+            }
         );
     }
     if (Pstream::parRun())
@@ -217,20 +228,22 @@ std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
             }
             DynamicList<label> ids, patches;
             DynamicList<point> xs;
+            DynamicList<vector> ns;
             label nSentFirst = 0;
             forAll(wall, c)
             {
                 const point& x = points0[wallPoints_[wall[c]]];
-                if (distSqrToBox(x, rankBox[proci]) <= outer*outer)
+                if (distSqrToBox(x, rankBox[proci]) <= reach*reach)
                 {
                     ids.append(wallIndex.toGlobal(wall[c]));
                     xs.append(x);
                     patches.append(patch[c]);
+                    ns.append(normalOf(wall[c]));
                     nSentFirst += c < nFirst;
                 }
             }
             UOPstream os(proci, buffers);
-            os << ids << xs << patches << nSentFirst;
+            os << ids << xs << patches << ns << nSentFirst;
         }
         buffers.finishedSends();
         for (label proci = 0; proci < Pstream::nProcs(); ++proci)
@@ -242,11 +255,15 @@ std::vector<Foam::rigidLayers::footCandidate> Foam::rigidLayers::footCandidates
             UIPstream is(proci, buffers);
             labelList ids, patches;
             List<point> xs;
+            List<vector> ns;
             label nSentFirst;
-            is >> ids >> xs >> patches >> nSentFirst;
+            is >> ids >> xs >> patches >> ns >> nSentFirst;
             forAll(ids, c)
             {
-                (c < nSentFirst ? cand : others).push_back({ids[c], xs[c], patches[c], false});
+                (c < nSentFirst ? cand : others).push_back
+                (
+                    {ids[c], xs[c], patches[c], false, ns[c]}
+                );
             }
         }
     }
@@ -276,6 +293,7 @@ void Foam::rigidLayers::findFeet
     pairArm_.clear();
     pairShare_.clear();
     pairFollows_.clear();
+    facingGaps_.clear();
     if (nNearest == 0)
     {
         return;
@@ -340,13 +358,16 @@ void Foam::rigidLayers::findFeet
         weights.append(weight(d, innerDistance_, outerDistance_));
         arms.append(x - cand[best].x);
 
-        // The nearest foot on another listed wall, nearer than d + width
-        // (width: innerDistance, less where that would reach past
-        // outerDistance; ties: the first listed wall, then preferred())
+        // The nearest foot on another listed wall (ties: the first listed
+        // wall, then preferred()), within 2 outerDistance - d, where the
+        // gap between the walls, if they face each other there, is
+        // narrower than twice outerDistance; and if it is nearer than
+        // d + width (width: innerDistance, less where that would reach
+        // past outerDistance) the point's pair foot
         const scalar width = min(innerDistance_, outerDistance_ - d);
         label pairPatch = -1;
         label pairBest = -1;
-        scalar pairSqr = sqr(d + width);
+        scalar pairSqr = sqr(max(d + width, 2*outerDistance_ - d));
         for (label k = 0; k < nPatches; ++k)
         {
             if
@@ -373,6 +394,10 @@ void Foam::rigidLayers::findFeet
             }
         }
         if (pairPatch >= 0)
+        {
+            noteFacingGap(cand[best], patchCand[pairPatch][pairBest], x);
+        }
+        if (pairPatch >= 0 && pairSqr < sqr(d + width))
         {
             const footCandidate& c = patchCand[pairPatch][pairBest];
             zonePair.resize(zone.size(), -1);

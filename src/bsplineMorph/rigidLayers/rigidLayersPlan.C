@@ -334,13 +334,22 @@ void Foam::rigidLayers::plan
         {
             smoothWall_.set(wi, smoothSurface_[pointPatch[wallPoints_[wi]]] && rough[wi] == 0);
         }
-        wallNormal0_ = smoothWallNormals(points0, nullptr);
+        wallNormal0_ = wallNormals(smoothSurface_, points0, nullptr);
     }
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;
     const std::vector<footCandidate> cand
     (
-        footCandidates(points0, wallIndex, pointPatch, nNearest)
+        footCandidates
+        (
+            points0,
+            wallIndex,
+            pointPatch,
+            patchIDs_.size() > 1
+          ? wallNormals(boolList(patchIDs_.size(), true), points0, nullptr)
+          : vectorField(),
+            nNearest
+        )
     );
     findFeet(points0, cand, nNearest, kind);
     anyPair_ = returnReduce(pairFoot_.size() > 0, orOp<bool>());
@@ -419,57 +428,96 @@ void Foam::rigidLayers::plan
 }
 
 
+void Foam::rigidLayers::noteFacingGap
+(
+    const footCandidate& a,
+    const footCandidate& b,
+    const point& x
+)
+{
+    // (the normals are the faces' area vectors', out of the mesh: a point
+    // in front of a wall lies against its normal)
+    const scalar cos30 = std::cos(degToRad(30.0));
+    const vector armA = x - a.x;
+    const vector armB = x - b.x;
+    const scalar gap = mag(armA) + mag(armB);
+    if
+    (
+        gap < (2 - 1e-9)*outerDistance_
+     && (a.n & b.n) < -cos30*mag(a.n)*mag(b.n)
+     && (armA & a.n) < -cos30*mag(armA)*mag(a.n)
+     && (armB & b.n) < -cos30*mag(armB)*mag(b.n)
+    )
+    {
+        const label n = patchIDs_.size();
+        const label key = min(a.patch, b.patch)*n + max(a.patch, b.patch);
+        facingGaps_.set(key, min(gap, facingGaps_.lookup(key, GREAT)));
+    }
+}
+
+
 void Foam::rigidLayers::warnFacingGaps()
 {
-    if (facingWarned_ || !anyPair_)
+    if (facingWarned_ || patchIDs_.size() < 2)
     {
         return;
     }
-    // Per pair of listed walls (k < l: key k*n + l) the narrowest gap
-    const label n = patchIDs_.size();
-    const scalar facing = std::cos(degToRad(150.0));
-    Map<scalar> gaps;
-    forAll(zonePair_, i)
-    {
-        const label p = zonePair_[i];
-        if (p < 0)
-        {
-            continue;
-        }
-        const vector& a = zoneArm_[i];
-        const vector& b = pairArm_[p];
-        const scalar gap = mag(a) + mag(b);
-        // (a gap of twice outerDistance, to round-off, leaves its middle to
-        // the interpolated field)
-        if
-        (
-            gap < (2 - 1e-9)*outerDistance_
-         && mag(a) > 0 && mag(b) > 0 && (a & b) < facing*mag(a)*mag(b)
-        )
-        {
-            const label k = footPatch_[zoneFoot_[i]];
-            const label l = footPatch_[pairFoot_[p]];
-            const label key = min(k, l)*n + max(k, l);
-            gaps.set(key, min(gap, gaps.lookup(key, GREAT)));
-        }
-    }
+    Map<scalar> gaps(facingGaps_);
     Pstream::mapCombineGather(gaps, minEqOp<scalar>());
     Pstream::mapCombineScatter(gaps);
     if (gaps.empty())
     {
         return;
     }
-    facingWarned_ = true;
+    // Listed walls that share a point (on any rank) meet at a corner: no
+    // gap (each point's first and last listed patch: the pairs of those
+    // that meet along an edge)
     const polyBoundaryMesh& pbm = mesh_.boundaryMesh();
+    const label n = patchIDs_.size();
+    labelList first(mesh_.nPoints(), labelMax);
+    labelList last(mesh_.nPoints(), -1);
+    forAll(patchIDs_, k)
+    {
+        for (const label pointi : pbm[patchIDs_[k]].meshPoints())
+        {
+            first[pointi] = min(first[pointi], k);
+            last[pointi] = max(last[pointi], k);
+        }
+    }
+    syncTools::syncPointList(mesh_, first, minEqOp<label>(), labelMax);
+    syncTools::syncPointList(mesh_, last, maxEqOp<label>(), label(-1));
+    labelHashSet meet;
+    forAll(first, pointi)
+    {
+        if (last[pointi] > first[pointi])
+        {
+            meet.insert(first[pointi]*n + last[pointi]);
+        }
+    }
+    Pstream::combineGather(meet, HashSetOps::plusEqOp<label, Hash<label>>());
+    Pstream::combineScatter(meet);
     OStringStream which;
     scalar narrowest = GREAT;
     for (const label key : gaps.sortedToc())
     {
-        which<< (which.str().empty() ? "" : ", ")
-            << pbm[patchIDs_[key/n]].name() << " and "
-            << pbm[patchIDs_[key % n]].name() << " " << gaps[key] << " apart";
-        narrowest = min(narrowest, gaps[key]);
+        if (!meet.found(key))
+        {
+            which<< (narrowest < GREAT ? ", " : "")
+                << pbm[patchIDs_[key/n]].name() << " and "
+                << pbm[patchIDs_[key % n]].name() << " " << gaps[key] << " apart";
+            narrowest = min(narrowest, gaps[key]);
+        }
     }
+    if (narrowest == GREAT)
+    {
+        return;
+    }
+    facingWarned_ = true;
+    // (half the narrowest gap rounded down to 3 digits, so that an
+    // outerDistance copied from the message fits the gap; a half that has
+    // 3 digits, as 0.5, stays itself in spite of its quotient's round-off)
+    const scalar unit = std::pow(10, std::floor(std::log10(0.5*narrowest)) - 2);
+    const scalar half = std::floor(0.5*narrowest/unit*(1 + 1e-12))*unit;
     IOWarningInFunction(dict_)
         << "Listed walls face each other across gaps narrower than twice"
         << " outerDistance (" << 2*outerDistance_ << "): "
@@ -478,9 +526,10 @@ void Foam::rigidLayers::warnFacingGaps()
         << " part with their rigid motions, blended, rather than with the"
         << " interpolated field, and the cells between their rigid layers"
         << " take up the whole relative motion and fold early: an"
-        << " outerDistance of at most half the gap (" << 0.5*narrowest
-        << ") and an innerDistance that covers only the prism layers give"
-        << " those cells the most room" << endl;
+        << " outerDistance of half the narrowest gap (" << half << ") and"
+        << " an innerDistance of a third of that or less, covering the"
+        << " layers that must stay rigid, give those cells the most room"
+        << endl;
 }
 
 

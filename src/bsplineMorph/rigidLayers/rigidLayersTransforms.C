@@ -249,7 +249,7 @@ void Foam::rigidLayers::fitRotations
     // wall's points are known after the fit only.
     if (!known && smoothSurface_.found(true))
     {
-        const vectorField normal1(smoothWallNormals(points0, &displacement));
+        const vectorField normal1(wallNormals(smoothSurface_, points0, &displacement));
         for (const label wi : smoothWall_)
         {
             const scalar m0 = mag(wallNormal0_[wi]);
@@ -268,8 +268,9 @@ void Foam::rigidLayers::fitRotations
 }
 
 
-Foam::vectorField Foam::rigidLayers::smoothWallNormals
+Foam::vectorField Foam::rigidLayers::wallNormals
 (
+    const boolList& patches,
     const pointField& points0,
     const vectorField* displacement
 ) const
@@ -284,7 +285,7 @@ Foam::vectorField Foam::rigidLayers::smoothWallNormals
             const label start = wallFaceStart_[wallFacei];
             const label end = wallFaceStart_[++wallFacei];
             // (the face's points of its patch's kind are in face order)
-            for (label v = 0, i = start; smoothSurface_[k] && i < end && v < f.size(); ++v)
+            for (label v = 0, i = start; patches[k] && i < end && v < f.size(); ++v)
             {
                 if (wallPoints_[wallFacePoints_[i]] == f[v])
                 {
