@@ -115,8 +115,14 @@ void Foam::interpolatingMotionSolver::refuseInverted
         what<< "; " << nLayers.second() << " of them have a point near two"
             << " listed walls, where the walls' rigid motions blend: walls"
             << " that move against each other need room between their rigid"
-            << " layers (a smaller innerDistance; where they face each other"
-            << " across a gap, an outerDistance of half of it)";
+            << " layers (a smaller innerDistance)";
+    }
+    if (rigidLayersPtr_ && rigidLayersPtr_->facingGapsWarned())
+    {
+        what<< "; listed walls face each other across gaps narrower than"
+            << " twice outerDistance (the warning at the plan): an"
+            << " outerDistance of half the narrowest gap gives the cells"
+            << " between them the most room";
     }
     if (invertedCellsFatal_)
     {

@@ -436,17 +436,21 @@ void Foam::rigidLayers::noteFacingGap
 )
 {
     // (the normals are the faces' area vectors', out of the mesh: a point
-    // in front of a wall lies against its normal)
+    // in front of a wall lies against its normal; a point on a wall, its
+    // arm zero, is in front of it: a gap one cell across has no other)
     const scalar cos30 = std::cos(degToRad(30.0));
     const vector armA = x - a.x;
     const vector armB = x - b.x;
+    const auto inFront = [&](const vector& arm, const vector& n)
+    {
+        return mag(arm) == 0 || (arm & n) < -cos30*mag(arm)*mag(n);
+    };
     const scalar gap = mag(armA) + mag(armB);
     if
     (
-        gap < (2 - 1e-9)*outerDistance_
+        gap > 0 && gap < (2 - 1e-9)*outerDistance_
      && (a.n & b.n) < -cos30*mag(a.n)*mag(b.n)
-     && (armA & a.n) < -cos30*mag(armA)*mag(a.n)
-     && (armB & b.n) < -cos30*mag(armB)*mag(b.n)
+     && inFront(armA, a.n) && inFront(armB, b.n)
     )
     {
         const label n = patchIDs_.size();
@@ -513,9 +517,10 @@ void Foam::rigidLayers::warnFacingGaps()
         return;
     }
     facingWarned_ = true;
-    // (half the narrowest gap rounded down to 3 digits, so that an
-    // outerDistance copied from the message fits the gap; a half that has
-    // 3 digits, as 0.5, stays itself in spite of its quotient's round-off)
+    // (half the narrowest gap rounded down to 3 significant digits, so
+    // that an outerDistance copied from the message fits the gap; a half
+    // that has 3 digits, as 0.5, stays itself in spite of its quotient's
+    // round-off)
     const scalar unit = std::pow(10, std::floor(std::log10(0.5*narrowest)) - 2);
     const scalar half = std::floor(0.5*narrowest/unit*(1 + 1e-12))*unit;
     IOWarningInFunction(dict_)
