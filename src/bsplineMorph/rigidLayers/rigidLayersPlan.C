@@ -308,12 +308,20 @@ void Foam::rigidLayers::plan
         smoothSurface_[k] = bc.smoothProjectingPatches().found(patchIDs_[k]);
     }
     findWallPoints(points0, pointPatch, kind);
+    // Each wall point's normal in points0, summed over every listed patch's
+    // faces: the smooth walls' turn reads it at smoothWall_'s points (whose
+    // faces are all of smooth patches), the facing gaps (two listed patches
+    // or more) everywhere
+    wallNormal0_.clear();
+    if (patchIDs_.size() > 1 || smoothSurface_.found(true))
+    {
+        wallNormal0_ = wallNormals(boolList(patchIDs_.size(), true), points0, nullptr);
+    }
     // The wall points whose normal is their smooth surface's: their own
     // patch projects onto one, and none of their faces (on any rank) is of
     // a patch that does not (where such patches meet, the normal from their
     // faces turns abruptly)
     smoothWall_.clear();
-    wallNormal0_.clear();
     if (smoothSurface_.found(true))
     {
         scalarField rough(wallPoints_.size(), Zero);
@@ -334,22 +342,12 @@ void Foam::rigidLayers::plan
         {
             smoothWall_.set(wi, smoothSurface_[pointPatch[wallPoints_[wi]]] && rough[wi] == 0);
         }
-        wallNormal0_ = wallNormals(smoothSurface_, points0, nullptr);
     }
     const globalIndex wallIndex(wallPoints_.size());
     label nNearest = 0;
     const std::vector<footCandidate> cand
     (
-        footCandidates
-        (
-            points0,
-            wallIndex,
-            pointPatch,
-            patchIDs_.size() > 1
-          ? wallNormals(boolList(patchIDs_.size(), true), points0, nullptr)
-          : vectorField(),
-            nNearest
-        )
+        footCandidates(points0, wallIndex, pointPatch, wallNormal0_, nNearest)
     );
     findFeet(points0, cand, nNearest, kind);
     anyPair_ = returnReduce(pairFoot_.size() > 0, orOp<bool>());
