@@ -480,11 +480,25 @@ void Foam::rigidLayers::markRigid(bitSet& rigid) const
 
 Foam::labelPair Foam::rigidLayers::nCellsInBlendAndPairs(const labelList& cells) const
 {
+    // (paired: where the two walls' rigid motions differ there by more
+    // than round-off of the point's distances from them; the patches of
+    // one body that moves as a whole do not move against each other)
     bitSet blend(mesh_.nPoints()), paired(mesh_.nPoints());
     forAll(zonePoints_, i)
     {
         blend.set(zonePoints_[i], zoneWeight_[i] < 1);
-        paired.set(zonePoints_[i], zonePair_.size() && zonePair_[i] >= 0);
+        const label p = zonePair_.size() ? zonePair_[i] : -1;
+        if (p >= 0)
+        {
+            const vector apart =
+                rigidMotion(pairFoot_[p], pairArm_[p])
+              - rigidMotion(zoneFoot_[i], zoneArm_[i]);
+            paired.set
+            (
+                zonePoints_[i],
+                mag(apart) > 1e-9*(mag(zoneArm_[i]) + mag(pairArm_[p]) + outerDistance_)
+            );
+        }
     }
     labelPair n(0, 0);
     for (const label celli : cells)
