@@ -48,9 +48,10 @@ Description
     worstAngleChange). A column of layer cells starts at each wall face:
     layer 1 is its owner cell, and the face of a layer cell opposite to its
     bottom face (hex and prism cells) is the bottom face of the next layer's
-    cell. The column stops at a cell without an opposite face and at a
-    boundary face, except processor and cyclic faces, across which it goes on
-    (not across cyclicAMI). A layer cell's height is its volume / its bottom
+    cell. The column stops at a cell without one opposite face (the
+    polyhedra where snappyHexMesh's layers stop; the log says how many
+    columns end below each layer) and at a boundary face, except processor
+    and cyclic faces, across which it goes on (not across cyclicAMI). A layer cell's height is its volume / its bottom
     face's area, its angle the one between that face's normal (into the
     cell) and the face-to-cell-centre direction; layer 1 gives the
     first-layer measures above. A cell in two columns (near the corner of two
@@ -70,6 +71,8 @@ Usage
                 first-layer measures only, no morphQualityLayers.dat)
 
 \*---------------------------------------------------------------------------*/
+
+#include <algorithm>
 
 #include "argList.H"
 #include "timeSelector.H"
@@ -142,6 +145,38 @@ struct layerCells
     labelList cells;
 };
 
+// The face of cell c opposite its face f: the one face of the same size
+// that shares no point with f (a hex's or prism's from that face), or -1.
+// (cell::opposingFaceLabel's test, without its message on each polyhedron,
+// as snappyHexMesh leaves where its layers stop)
+label opposingFace(const cell& c, const label f, const faceList& faces)
+{
+    const face& bottom = faces[f];
+    label found = -1;
+    for (const label g : c)
+    {
+        const face& other = faces[g];
+        if (g == f || other.size() != bottom.size())
+        {
+            continue;
+        }
+        const bool shares = std::any_of
+        (
+            other.begin(), other.end(),
+            [&](const label pointi) { return bottom.found(pointi); }
+        );
+        if (!shares)
+        {
+            if (found >= 0)
+            {
+                return -1;
+            }
+            found = g;
+        }
+    }
+    return found;
+}
+
 // The first nLayers layers of the columns on the wall faces (see the
 // description). Layer by layer: a column leaving through a processor or
 // cyclic face goes on in the cell on its other side, so each layer cell is on
@@ -176,7 +211,7 @@ List<layerCells> walkLayers
         forAll(below.faces, i)
         {
             const label celli = below.cells[i];
-            const label topi = cells[celli].opposingFaceLabel(below.faces[i], faces);
+            const label topi = opposingFace(cells[celli], below.faces[i], faces);
             if (topi < 0)
             {
                 continue;   // not a hex or prism seen from this face
@@ -388,10 +423,21 @@ int main(int argc, char *argv[])
     }
     List<layerCells> layers(walkLayers(mesh, wallFaces, nLayers));
     // The columns end where the mesh does: the layers past the deepest cell
-    // are not measured (they have no cells to compare)
+    // are not measured (they have no cells to compare). Columns that end
+    // sooner (a cell with no single face opposite the one below) are said
     forAll(layers, k)
     {
-        if (returnReduce(layers[k].cells.size(), sumOp<label>()) == 0)
+        const label n = returnReduce(layers[k].cells.size(), sumOp<label>());
+        const label above = k ? returnReduce(layers[k - 1].cells.size(), sumOp<label>()) : n;
+        if (n > 0 && n < above)
+        {
+            Info<< "-layers " << nLayers << ": " << above - n << " of the "
+                << above << " columns on " << flatOutput(wallNames)
+                << " end below layer " << k + 1 << " (a cell with no single"
+                << " face opposite the one below: not a hex or prism seen"
+                << " from it, or the mesh's boundary)" << nl << endl;
+        }
+        if (n == 0)
         {
             Info<< "-layers " << nLayers << ": the columns on "
                 << flatOutput(wallNames) << " end after " << k
