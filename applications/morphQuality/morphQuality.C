@@ -51,9 +51,10 @@ Description
     cell. The column stops at a cell without one opposite face (the
     polyhedra where snappyHexMesh's layers stop; the log says how many
     columns end below each layer) and at a boundary face, except processor
-    and cyclic faces, across which it goes on (not across cyclicAMI). A layer cell's height is its volume / its bottom
-    face's area, its angle the one between that face's normal (into the
-    cell) and the face-to-cell-centre direction; layer 1 gives the
+    and cyclic faces, across which it goes on (not across cyclicAMI). A
+    layer cell's height is its volume / its bottom face's area, its angle
+    the one between that face's normal (into the cell) and the
+    face-to-cell-centre direction; layer 1 gives the
     first-layer measures above. A cell in two columns (near the corner of two
     walls) counts in each.
 
