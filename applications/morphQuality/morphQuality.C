@@ -426,11 +426,11 @@ int main(int argc, char *argv[])
     // The columns end where the mesh does: the layers past the deepest cell
     // are not measured (they have no cells to compare). Columns that end
     // sooner (a cell with no single face opposite the one below) are said
+    label above = -1;
     forAll(layers, k)
     {
         const label n = returnReduce(layers[k].cells.size(), sumOp<label>());
-        const label above = k ? returnReduce(layers[k - 1].cells.size(), sumOp<label>()) : n;
-        if (n > 0 && n < above)
+        if (n > 0 && k > 0 && n < above)
         {
             Info<< "-layers " << nLayers << ": " << above - n << " of the "
                 << above << " columns on " << flatOutput(wallNames)
@@ -446,6 +446,7 @@ int main(int argc, char *argv[])
             layers.setSize(k);
             break;
         }
+        above = n;
     }
 
     // The undeformed mesh
