@@ -350,6 +350,7 @@ Foam::boundaryConstraints::boundaryConstraints
 void Foam::boundaryConstraints::checkCouplings
 (
     const pointVectorField& pointDisplacement,
+    const pointField& points0,
     const word& solver
 )
 {
@@ -377,6 +378,7 @@ void Foam::boundaryConstraints::checkCouplings
                 << " is accepted. The mesh is not moved" << exit(FatalError);
         }
     }
+    warnSplitBaffles(pbm.mesh(), points0);
 }
 
 

@@ -284,7 +284,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     checkZoneBorder_(false)
 {
-    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), this->points0(), type);
     readBase(type);
     findZoneBorder();
 }
@@ -306,7 +306,7 @@ Foam::interpolatingMotionSolver::interpolatingMotionSolver
     rigidLayersPtr_(rigidLayers::New(mesh, coeffDict())),
     checkZoneBorder_(false)
 {
-    boundaryConstraints::checkCouplings(this->pointDisplacement(), type);
+    boundaryConstraints::checkCouplings(this->pointDisplacement(), this->points0(), type);
     readBase(type);
     findZoneBorder();
 }
