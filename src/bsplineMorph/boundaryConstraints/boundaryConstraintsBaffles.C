@@ -24,18 +24,31 @@ License
 #include "OStringStream.H"
 
 #include <algorithm>
+#include <vector>
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
 
 namespace
 {
+    using namespace Foam;
+
     // Lexicographic order of points (copies of a point are equal bit for bit)
-    bool before(const Foam::point& a, const Foam::point& b)
+    bool before(const point& a, const point& b)
     {
         return
             a.x() < b.x()
          || (a.x() == b.x() && (a.y() < b.y() || (a.y() == b.y() && a.z() < b.z())));
     }
+
+    // A copy of a boundary point: where, on which rank, its global point
+    // (processor faces join copies into one) and its patch
+    struct pointCopy
+    {
+        point x;
+        label rank;
+        label global;
+        label patch;
+    };
 }
 
 
@@ -51,10 +64,9 @@ void Foam::boundaryConstraints::warnSplitBaffles
     {
         return;
     }
-    // This rank's points of patches that are not couplings (nor empty: a
-    // cyclicAMI's sides are separate points however decomposed), with the
-    // first such patch that holds them, but those on coupled patches
-    // (joined to their copies on other ranks)
+    // This rank's points of patches that are not couplings (a cyclicAMI's
+    // sides are separate points however decomposed) nor empty, with the
+    // first such patch that holds them and their global point
     const polyBoundaryMesh& pbm = mesh.boundaryMesh();
     labelList patchOf(mesh.nPoints(), -1);
     forAllReverse(pbm, patchi)
@@ -65,68 +77,109 @@ void Foam::boundaryConstraints::warnSplitBaffles
             UIndirectList<label>(patchOf, pp.meshPoints()) = patchi;
         }
     }
-    UIndirectList<label>(patchOf, mesh.globalData().coupledPatch().meshPoints()) = -1;
-    DynamicList<label> points;
+    labelList toGlobal, unique;
+    mesh.globalData().mergePoints(toGlobal, unique);
+    const label myProc = Pstream::myProcNo();
+    std::vector<pointCopy> copies;
     forAll(patchOf, pointi)
     {
         if (patchOf[pointi] >= 0)
         {
-            points.append(pointi);
+            copies.push_back({points0[pointi], myProc, toGlobal[pointi], patchOf[pointi]});
         }
     }
-    std::sort
-    (
-        points.begin(),
-        points.end(),
-        [&](const label a, const label b) { return before(points0[a], points0[b]); }
-    );
-    const pointField x(points0, points);
+    boundBox box;
+    for (const pointCopy& c : copies)
+    {
+        box.add(c.x);
+    }
 
-    // Each rank sends the points within the bounding boxes of the higher
-    // ranks' to them (each pair of copies found once, by the higher rank)
-    const label myProc = Pstream::myProcNo();
+    // Each rank sends those within another rank's bounding box to it: a
+    // rank gets every copy of each of its points
     List<boundBox> rankBox(Pstream::nProcs());
-    rankBox[myProc] = boundBox(x, false);
+    rankBox[myProc] = box;
     Pstream::gatherList(rankBox);
     Pstream::scatterList(rankBox);
     PstreamBuffers buffers(Pstream::commsTypes::nonBlocking);
-    for (label proci = myProc + 1; proci < Pstream::nProcs(); ++proci)
+    const label nMine = label(copies.size());
+    for (label proci = 0; proci < Pstream::nProcs(); ++proci)
     {
-        DynamicList<point> xs;
-        DynamicList<label> patches;
-        forAll(x, i)
+        if (proci == myProc)
         {
-            if (rankBox[proci].contains(x[i]))
+            continue;
+        }
+        DynamicList<point> xs;
+        DynamicList<label> globals, patches;
+        for (label i = 0; i < nMine; ++i)
+        {
+            if (rankBox[proci].contains(copies[i].x))
             {
-                xs.append(x[i]);
-                patches.append(patchOf[points[i]]);
+                xs.append(copies[i].x);
+                globals.append(copies[i].global);
+                patches.append(copies[i].patch);
             }
         }
         UOPstream os(proci, buffers);
-        os << xs << patches;
+        os << xs << globals << patches;
     }
     buffers.finishedSends();
-    label nCopies = 0;
-    boolList named(pbm.size(), false);
-    for (label proci = 0; proci < myProc; ++proci)
+    for (label proci = 0; proci < Pstream::nProcs(); ++proci)
     {
+        if (proci == myProc)
+        {
+            continue;
+        }
         UIPstream is(proci, buffers);
         List<point> xs;
-        labelList patches;
-        is >> xs >> patches;
+        labelList globals, patches;
+        is >> xs >> globals >> patches;
         forAll(xs, i)
         {
-            const auto at = std::lower_bound(x.begin(), x.end(), xs[i], before);
-            if (at != x.end() && *at == xs[i])
+            copies.push_back({xs[i], proci, globals[i], patches[i]});
+        }
+    }
+
+    // Each place with a copy here, counted by the lowest rank that has one:
+    // split where it has more global points than any rank holds there (a
+    // rank that holds two has two points in the mesh itself: split baffles)
+    std::sort
+    (
+        copies.begin(),
+        copies.end(),
+        [](const pointCopy& a, const pointCopy& b)
+        {
+            return
+                before(a.x, b.x)
+             || (a.x == b.x && (a.rank < b.rank || (a.rank == b.rank && a.global < b.global)));
+        }
+    );
+    label nSplit = 0;
+    boolList named(pbm.nNonProcessor(), false);
+    std::vector<label> globals;
+    for (std::size_t i = 0, j; i < copies.size(); i = j)
+    {
+        globals.clear();
+        label mostOnRank = 0, onRank = 0;
+        for (j = i; j < copies.size() && copies[j].x == copies[i].x; ++j)
+        {
+            globals.push_back(copies[j].global);
+            onRank = j > i && copies[j].rank == copies[j - 1].rank ? onRank + 1 : 1;
+            mostOnRank = max(mostOnRank, onRank);
+        }
+        std::sort(globals.begin(), globals.end());
+        const label nGlobal =
+            std::unique(globals.begin(), globals.end()) - globals.begin();
+        if (copies[i].rank == myProc && nGlobal > mostOnRank)
+        {
+            ++nSplit;
+            for (std::size_t k = i; k < j; ++k)
             {
-                ++nCopies;
-                named[patches[i]] = true;
-                named[patchOf[points[at - x.begin()]]] = true;
+                named[copies[k].patch] = true;
             }
         }
     }
-    reduce(nCopies, sumOp<label>());
-    if (nCopies == 0)
+    reduce(nSplit, sumOp<label>());
+    if (nSplit == 0)
     {
         return;
     }
@@ -141,17 +194,18 @@ void Foam::boundaryConstraints::warnSplitBaffles
         }
     }
     WarningInFunction
-        << nCopies << " boundary points of the patches " << names.str().c_str()
-        << ")"
-        << " lie on two ranks with no processor face joining them: a baffle"
-        << " that a processor boundary runs along (unless the mesh has two"
-        << " points there itself: split baffles, meshes merged without"
-        << " stitching). Each rank's copy is a"
-        << " control point of its own, so the result differs from a serial"
-        << " run's, and where the baffle's two sides move differently each"
-        << " copy moves with its own side. Decompose with constraints"
-        << " { baffles { type preserveBaffles; } } in"
-        << " system/decomposeParDict to keep each baffle on one rank" << endl;
+        << nSplit << " boundary points of the patches " << names.str().c_str()
+        << ") lie on several ranks with no processor face joining them: a"
+        << " baffle that a processor boundary runs along (unless the mesh"
+        << " has separate points there itself: split baffles, meshes merged"
+        << " without stitching). Each rank's copy is a point of its own:"
+        << " where the baffle's sides move differently each copy moves with"
+        << " its own side (in a serial run the one point moves with the"
+        << " later patch), and multilevelBSpline's fit counts each copy as a"
+        << " control point, so its result differs from a serial run's even"
+        << " where they move alike. Decompose with constraints { baffles"
+        << " { type preserveBaffles; } } in system/decomposeParDict to keep"
+        << " each baffle on one rank" << endl;
 }
 
 
