@@ -12,7 +12,9 @@ tutorial case against the motion's amplitude).
         the table of the runs ROWS lists (printed and written to MD: each
         method and amplitude, and the largest amplitude each method survives:
         run completed, no invalid cell) and the plot PNG of the measures
-        against the amplitude (AMPNAME its axis label; matplotlib)
+        against the amplitude (AMPNAME its axis label; matplotlib): of the
+        meshes without invalid cells, and the invalid cells of every
+        completed run
     compareReport.py label METHOD
         the method's name in the tables (S/on/I/L: "S, rigidLayers on, I level L")
 
@@ -118,17 +120,27 @@ def report(case, rowsPath, mdPath, pngPath, ampName):
     panels = [("maxNonOrth", "max non-orthogonality [deg]"), ("maxSkewness", "max skewness"),
               ("minVolRatio", "min cell volume ratio"), ("worstLayerHeightChange", "|worst first-layer height change|"),
               ("worstLayerAngleChange", "|worst first-layer angle change| [deg]"), ("nInvalid", "invalid cells")]
-    fig, axes = plt.subplots(2, 3, figsize=(13, 7.5))
+    # (the measures of valid meshes only: a folded mesh's skewness or volume
+    # ratio, thousands, would flatten every other curve; the invalid cells
+    # of every completed run; each method in its own colour, every panel
+    # over all amplitudes run)
+    fig, axes = plt.subplots(2, 3, figsize=(13, 8))
+    colour = {s: "C%d" % (i % 10) for i, s in enumerate(solvers)}
+    lo, hi = min(r[1] for r in runs), max(r[1] for r in runs)
     for ax, (key, title) in zip(axes.flat, panels):
+        shown = (lambda m, st: m is not None and st == "completed") if key == "nInvalid" else ok
         for s in solvers:
-            pts = [(a, abs(m[key])) for t, a, m, st in runs if t == s and m is not None and st == "completed"]
+            pts = [(a, abs(m[key])) for t, a, m, st in runs if t == s and shown(m, st)]
             if pts:
-                ax.plot(*zip(*pts), marker="o", label=s)
+                ax.plot(*zip(*pts), marker="o", color=colour[s])
         ax.set_title(title, fontsize=10); ax.set_xlabel(ampName)
         ax.grid(alpha=0.3)
-    axes.flat[0].legend(fontsize=8)
-    fig.suptitle("%s: morphing quality versus amplitude (completed runs)" % case)
-    fig.tight_layout()
+        ax.set_xlim(lo - 0.05*(hi - lo), hi + 0.05*(hi - lo))
+    fig.legend([plt.Line2D([], [], marker="o", color=colour[s]) for s in solvers], solvers,
+               loc="lower center", ncol=3, fontsize=8)
+    fig.suptitle("%s: morphing quality versus amplitude (meshes without invalid cells; invalid cells: every"
+                 " completed run)" % case, fontsize=11)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(pngPath, dpi=110)
     print("compare: wrote", pngPath)
 
