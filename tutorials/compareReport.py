@@ -126,7 +126,9 @@ def report(case, rowsPath, mdPath, pngPath, ampName):
     # over all amplitudes run)
     fig, axes = plt.subplots(2, 3, figsize=(13, 8))
     colour = {s: "C%d" % (i % 10) for i, s in enumerate(solvers)}
-    lo, hi = min(r[1] for r in runs), max(r[1] for r in runs)
+    amps = [r[1] for r in runs] or [0]
+    pad = 0.05*(max(amps) - min(amps)) or 0.5
+    lo, hi = min(amps) - pad, max(amps) + pad
     for ax, (key, title) in zip(axes.flat, panels):
         shown = (lambda m, st: m is not None and st == "completed") if key == "nInvalid" else ok
         for s in solvers:
@@ -135,7 +137,7 @@ def report(case, rowsPath, mdPath, pngPath, ampName):
                 ax.plot(*zip(*pts), marker="o", color=colour[s])
         ax.set_title(title, fontsize=10); ax.set_xlabel(ampName)
         ax.grid(alpha=0.3)
-        ax.set_xlim(lo - 0.05*(hi - lo), hi + 0.05*(hi - lo))
+        ax.set_xlim(lo, hi)
     fig.legend([plt.Line2D([], [], marker="o", color=colour[s]) for s in solvers], solvers,
                loc="lower center", ncol=3, fontsize=8)
     fig.suptitle("%s: morphing quality versus amplitude (meshes without invalid cells; invalid cells: every"

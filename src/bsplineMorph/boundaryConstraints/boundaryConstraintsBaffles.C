@@ -95,7 +95,9 @@ void Foam::boundaryConstraints::warnSplitBaffles
     }
 
     // Each rank sends those within another rank's bounding box to it: a
-    // rank gets every copy of each of its points
+    // rank gets every copy of each of its points (once a run: a few
+    // points per rank where the ranks are boxes or slabs, more where
+    // their boxes overlap much)
     List<boundBox> rankBox(Pstream::nProcs());
     rankBox[myProc] = box;
     Pstream::gatherList(rankBox);
