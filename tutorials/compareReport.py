@@ -86,14 +86,15 @@ def readRuns(rowsPath):
 def report(case, rowsPath, mdPath, pngPath, ampName):
     runs = readRuns(rowsPath)
     solvers = list(dict.fromkeys(r[0] for r in runs))
-    ok = lambda m, status: m is not None and status == "completed" and m["nInvalid"] == 0
+    completed = lambda m, status: m is not None and status == "completed"
+    ok = lambda m, status: completed(m, status) and m["nInvalid"] == 0
     out = ["| method | amplitude | run | max non-orth [deg] | max skewness | min determinant | volume ratio min / max "
            "| invalid cells | first-layer height change mean / worst | first-layer angle change mean / worst [deg] "
            "| all layers: largest height / angle change |",
            "|---|---|---|---|---|---|---|---|---|---|---|"]
     small = lambda x, fmt: ("%.0e" % x) if x != 0 and abs(x) < 1e-3 else fmt % x
     for s, a, m, st in runs:
-        if m is None or st != "completed":
+        if not completed(m, st):
             out.append("| %s | %g | %s | - | - | - | - | - | - | - | - |" % (s, a, st)); continue
         layersCol = "-" if m["allLayersHeight"] is None else "%s%% / %s" % (
             small(100*m["allLayersHeight"], "%.1f"), small(m["allLayersAngle"], "%.2f"))
@@ -130,7 +131,7 @@ def report(case, rowsPath, mdPath, pngPath, ampName):
     pad = 0.05*(max(amps) - min(amps)) or 0.5
     lo, hi = min(amps) - pad, max(amps) + pad
     for ax, (key, title) in zip(axes.flat, panels):
-        shown = (lambda m, st: m is not None and st == "completed") if key == "nInvalid" else ok
+        shown = completed if key == "nInvalid" else ok
         for s in solvers:
             pts = [(a, abs(m[key])) for t, a, m, st in runs if t == s and shown(m, st)]
             if pts:
