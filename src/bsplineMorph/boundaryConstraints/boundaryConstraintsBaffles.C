@@ -22,8 +22,10 @@ License
 #include "coupledPolyPatch.H"
 #include "PstreamBuffers.H"
 #include "OStringStream.H"
+#include "labelIOList.H"
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 // * * * * * * * * * * * * * * * Local Functions * * * * * * * * * * * * * * //
@@ -41,14 +43,52 @@ namespace
     }
 
     // A copy of a boundary point: where, on which rank, its global point
-    // (processor faces join copies into one) and its patch
+    // (processor faces join copies into one), its point in the undecomposed
+    // mesh (-1: not known) and its patch
     struct pointCopy
     {
         point x;
         label rank;
         label global;
+        label original;
         label patch;
     };
+
+    // Each point's label in the undecomposed mesh, from the
+    // pointProcAddressing that decomposePar (or redistributePar) wrote
+    // beside this mesh's faces, where every rank has one of its size: empty
+    // otherwise (snappyHexMesh -parallel and other topology changes leave
+    // none there, or one of another size) (collective)
+    labelList undecomposedPoints(const polyMesh& mesh)
+    {
+        IOobject io
+        (
+            "pointProcAddressing",
+            mesh.facesInstance(),
+            mesh.meshSubDir,
+            mesh,
+            IOobject::MUST_READ,
+            IOobject::NO_WRITE,
+            false
+        );
+        labelList original;
+        if (io.typeHeaderOk<labelIOList>(true))
+        {
+            original = labelIOList(io);
+        }
+        if (!returnReduce(original.size() == mesh.nPoints(), andOp<bool>()))
+        {
+            original.clear();
+        }
+        return original;
+    }
+
+    // How many different labels
+    label nDistinct(std::vector<label>& labels)
+    {
+        std::sort(labels.begin(), labels.end());
+        return std::unique(labels.begin(), labels.end()) - labels.begin();
+    }
 }
 
 
@@ -79,13 +119,21 @@ void Foam::boundaryConstraints::warnSplitBaffles
     }
     labelList toGlobal, unique;
     mesh.globalData().mergePoints(toGlobal, unique);
+    const labelList original(undecomposedPoints(mesh));
     const label myProc = Pstream::myProcNo();
     std::vector<pointCopy> copies;
     forAll(patchOf, pointi)
     {
         if (patchOf[pointi] >= 0)
         {
-            copies.push_back({points0[pointi], myProc, toGlobal[pointi], patchOf[pointi]});
+            copies.push_back
+            ({
+                points0[pointi],
+                myProc,
+                toGlobal[pointi],
+                original.empty() ? -1 : original[pointi],
+                patchOf[pointi]
+            });
         }
     }
     boundBox box;
@@ -111,18 +159,19 @@ void Foam::boundaryConstraints::warnSplitBaffles
             continue;
         }
         DynamicList<point> xs;
-        DynamicList<label> globals, patches;
+        DynamicList<label> globals, originals, patches;
         for (label i = 0; i < nMine; ++i)
         {
             if (rankBox[proci].contains(copies[i].x))
             {
                 xs.append(copies[i].x);
                 globals.append(copies[i].global);
+                originals.append(copies[i].original);
                 patches.append(copies[i].patch);
             }
         }
         UOPstream os(proci, buffers);
-        os << xs << globals << patches;
+        os << xs << globals << originals << patches;
     }
     buffers.finishedSends();
     for (label proci = 0; proci < Pstream::nProcs(); ++proci)
@@ -133,17 +182,20 @@ void Foam::boundaryConstraints::warnSplitBaffles
         }
         UIPstream is(proci, buffers);
         List<point> xs;
-        labelList globals, patches;
-        is >> xs >> globals >> patches;
+        labelList globals, originals, patches;
+        is >> xs >> globals >> originals >> patches;
         forAll(xs, i)
         {
-            copies.push_back({xs[i], proci, globals[i], patches[i]});
+            copies.push_back({xs[i], proci, globals[i], originals[i], patches[i]});
         }
     }
 
     // Each place with a copy here, counted by the lowest rank that has one:
-    // split where it has more global points than any rank holds there (a
-    // rank that holds two has two points in the mesh itself: split baffles)
+    // split where it has more global points than the undecomposed mesh has
+    // points there, or, where that is not known, than any rank holds there
+    // (a rank that holds two has two points in the mesh itself: split
+    // baffles). Copies of one global point with different undecomposed
+    // points: the addressing is not this mesh's, and is not used.
     std::sort
     (
         copies.begin(),
@@ -155,52 +207,81 @@ void Foam::boundaryConstraints::warnSplitBaffles
              || (a.x == b.x && (a.rank < b.rank || (a.rank == b.rank && a.global < b.global)));
         }
     );
-    label nSplit = 0;
-    boolList named(pbm.nNonProcessor(), false);
-    std::vector<label> globals;
+    const bool known = !original.empty();
+    label nSplit[2] = {0, 0};      // by the undecomposed mesh, by the ranks
+    bool stale = false;
+    List<boolList> named(2, boolList(pbm.nNonProcessor(), false));
+    std::vector<label> globals, originals;
+    std::vector<std::pair<label, label>> pairs;
     for (std::size_t i = 0, j; i < copies.size(); i = j)
     {
         globals.clear();
+        originals.clear();
         label mostOnRank = 0, onRank = 0;
         for (j = i; j < copies.size() && copies[j].x == copies[i].x; ++j)
         {
             globals.push_back(copies[j].global);
+            originals.push_back(copies[j].original);
             onRank = j > i && copies[j].rank == copies[j - 1].rank ? onRank + 1 : 1;
             mostOnRank = max(mostOnRank, onRank);
         }
-        std::sort(globals.begin(), globals.end());
-        const label nGlobal =
-            std::unique(globals.begin(), globals.end()) - globals.begin();
-        if (copies[i].rank == myProc && nGlobal > mostOnRank)
+        if (copies[i].rank != myProc)
         {
-            ++nSplit;
+            continue;
+        }
+        const label nGlobal = nDistinct(globals);
+        const label nOriginal = nDistinct(originals);
+        if (known)
+        {
+            pairs.clear();
             for (std::size_t k = i; k < j; ++k)
             {
-                named[copies[k].patch] = true;
+                pairs.push_back({copies[k].global, copies[k].original});
+            }
+            std::sort(pairs.begin(), pairs.end());
+            stale = stale || std::unique(pairs.begin(), pairs.end()) - pairs.begin() > nGlobal;
+        }
+        const bool split[2] = {known && nGlobal > nOriginal, nGlobal > mostOnRank};
+        for (const label by : {0, 1})
+        {
+            if (split[by])
+            {
+                ++nSplit[by];
+                for (std::size_t k = i; k < j; ++k)
+                {
+                    named[by][copies[k].patch] = true;
+                }
             }
         }
     }
-    reduce(nSplit, sumOp<label>());
-    if (nSplit == 0)
+    const label by = known && !returnReduce(stale, orOp<bool>()) ? 0 : 1;
+    const label nSplitBy = returnReduce(nSplit[by], sumOp<label>());
+    if (nSplitBy == 0)
     {
         return;
     }
-    Pstream::listCombineGather(named, orEqOp<bool>());
-    Pstream::listCombineScatter(named);
+    boolList& namedBy = named[by];
+    Pstream::listCombineGather(namedBy, orEqOp<bool>());
+    Pstream::listCombineScatter(namedBy);
     OStringStream names;
-    forAll(named, patchi)
+    forAll(namedBy, patchi)
     {
-        if (named[patchi])
+        if (namedBy[patchi])
         {
             names<< (names.str().empty() ? "(" : " ") << pbm[patchi].name();
         }
     }
     WarningInFunction
-        << nSplit << " boundary points of the patches " << names.str().c_str()
+        << nSplitBy << " boundary points of the patches " << names.str().c_str()
         << ") lie on several ranks with no processor face joining them: a"
-        << " baffle that a processor boundary runs along (unless the mesh"
-        << " has separate points there itself: split baffles, meshes merged"
-        << " without stitching). Each rank's copy is a point of its own:"
+        << " baffle that a processor boundary runs along"
+        << (
+               by == 0 ? ""
+             : " (unless the mesh has separate points there itself: split"
+               " baffles, meshes merged without stitching; no"
+               " pointProcAddressing of this mesh from decomposePar tells)"
+           )
+        << ". Each rank's copy is a point of its own:"
         << " where the baffle's sides move differently each copy moves with"
         << " its own side (in a serial run the one point moves with the"
         << " later patch), and multilevelBSpline's fit counts each copy as a"
