@@ -235,10 +235,14 @@ void Foam::interpolatingMotionSolver::rebaseIfStrained()
     reduce(least, minOp<scalar>());
     if (least < rebaseVolumeRatio)
     {
+        // (a volume of the other sign or none: an inverted cell, which
+        // invertedCells warn let through)
         rebase
         (
-            "a cell's volume changed by a factor "
-          + Foam::name(1/max(least, VSMALL)) + " since " + baseName()
+            least > 0
+          ? "a cell's volume changed by a factor " + Foam::name(1/max(least, VSMALL))
+          + " since " + baseName()
+          : "a cell is inverted since " + baseName() + ", let through by invertedCells warn"
         );
     }
 }
