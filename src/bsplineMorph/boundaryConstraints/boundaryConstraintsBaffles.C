@@ -55,10 +55,10 @@ namespace
     };
 
     // Each point's label in the undecomposed mesh, from the
-    // pointProcAddressing that decomposePar (or redistributePar) wrote
-    // beside this mesh's faces, where every rank has one of its size: empty
-    // otherwise (snappyHexMesh -parallel and other topology changes leave
-    // none there, or one of another size) (collective)
+    // pointProcAddressing that decomposePar wrote beside this mesh's faces,
+    // where every rank has one of its size: empty otherwise (snappyHexMesh
+    // -parallel and other topology changes leave none there, or one of
+    // another size) (collective)
     labelList undecomposedPoints(const polyMesh& mesh)
     {
         IOobject io
