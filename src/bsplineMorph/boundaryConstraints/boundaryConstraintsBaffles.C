@@ -56,10 +56,10 @@ namespace
 
     // Each point's label in the undecomposed mesh, from the
     // pointProcAddressing that decomposePar wrote beside this mesh's faces,
-    // where every rank has one of its size: empty otherwise (snappyHexMesh
-    // -parallel and other topology changes leave none there, or one of
-    // another size) (collective)
-    labelList undecomposedPoints(const polyMesh& mesh)
+    // where every rank has one of its size (false: none; snappyHexMesh
+    // -parallel and other topology changes leave none there, or one of the
+    // old mesh's size) (collective)
+    bool undecomposedPoints(const polyMesh& mesh, labelList& original)
     {
         IOobject io
         (
@@ -71,16 +71,17 @@ namespace
             IOobject::NO_WRITE,
             false
         );
-        labelList original;
-        if (io.typeHeaderOk<labelIOList>(true))
+        original.clear();
+        const bool found =
+            returnReduce(io.typeHeaderOk<labelIOList>(true), andOp<bool>());
+        if (found)
         {
             original = labelIOList(io);
         }
-        if (!returnReduce(original.size() == mesh.nPoints(), andOp<bool>()))
-        {
-            original.clear();
-        }
-        return original;
+        // (a rank without points has an empty list: known all the same)
+        return
+            found
+         && returnReduce(original.size() == mesh.nPoints(), andOp<bool>());
     }
 
     // How many different labels
@@ -119,7 +120,8 @@ void Foam::boundaryConstraints::warnSplitBaffles
     }
     labelList toGlobal, unique;
     mesh.globalData().mergePoints(toGlobal, unique);
-    const labelList original(undecomposedPoints(mesh));
+    labelList original;
+    const bool known = undecomposedPoints(mesh, original);
     const label myProc = Pstream::myProcNo();
     std::vector<pointCopy> copies;
     forAll(patchOf, pointi)
@@ -131,7 +133,7 @@ void Foam::boundaryConstraints::warnSplitBaffles
                 points0[pointi],
                 myProc,
                 toGlobal[pointi],
-                original.empty() ? -1 : original[pointi],
+                known ? original[pointi] : -1,
                 patchOf[pointi]
             });
         }
@@ -195,7 +197,9 @@ void Foam::boundaryConstraints::warnSplitBaffles
     // points there, or, where that is not known, than any rank holds there
     // (a rank that holds two has two points in the mesh itself: split
     // baffles). Copies of one global point with different undecomposed
-    // points: the addressing is not this mesh's, and is not used.
+    // points: the addressing is not this mesh's, and is not used (so too
+    // where a collocated cyclic, which mergePoints merges, joins them: the
+    // count then is the ranks')
     std::sort
     (
         copies.begin(),
@@ -207,7 +211,6 @@ void Foam::boundaryConstraints::warnSplitBaffles
              || (a.x == b.x && (a.rank < b.rank || (a.rank == b.rank && a.global < b.global)));
         }
     );
-    const bool known = !original.empty();
     label nSplit[2] = {0, 0};      // by the undecomposed mesh, by the ranks
     bool stale = false;
     List<boolList> named(2, boolList(pbm.nNonProcessor(), false));

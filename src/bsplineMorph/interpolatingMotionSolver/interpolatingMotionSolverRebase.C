@@ -235,14 +235,15 @@ void Foam::interpolatingMotionSolver::rebaseIfStrained()
     reduce(least, minOp<scalar>());
     if (least < rebaseVolumeRatio)
     {
-        // (a volume of the other sign or none: an inverted cell, which
-        // invertedCells warn let through)
+        // (a volume of the other sign or none: an inverted cell, now or in
+        // the base, which invertedCells warn let through)
         rebase
         (
             least > 0
           ? "a cell's volume changed by a factor " + Foam::name(1/max(least, VSMALL))
           + " since " + baseName()
-          : "a cell is inverted since " + baseName() + ", let through by invertedCells warn"
+          : "a cell's volume changed sign since " + baseName()
+          + " (invertedCells warn lets inverted cells through)"
         );
     }
 }
