@@ -530,7 +530,8 @@ void Foam::boundaryConstraints::warnCyclicConflicts
 )
 {
     // (after the syncs: a point whose index rose above its own patches'
-    // took a later patch's at a partner, its value through the transform)
+    // took a later patch's at a partner, its value through the transform;
+    // one whose partner is of the same patch took the larger of the two)
     const scalar meshSize = pMesh_().bounds().mag();
     const polyBoundaryMesh& patches = pMesh_().boundaryMesh();
     wordHashSet overruled;
@@ -540,16 +541,14 @@ void Foam::boundaryConstraints::warnCyclicConflicts
         const label i = ownFixed[j];
         const label pointi = cyclicPoints_[i];
         const scalar d = mag(value_[pointi] - ownValue[j]);
-        if
-        (
-            fixedSync_[pointi] > cyclicOwnFixed_[i]
-         && beyondRoundOff(d, max(mag(value_[pointi]), mag(ownValue[j])), meshSize)
-        )
+        if (beyondRoundOff(d, max(mag(value_[pointi]), mag(ownValue[j])), meshSize))
         {
+            const word& own = patches[cyclicOwnFixed_[i] - 1].name();
             overruled.insert
             (
-                patches[cyclicOwnFixed_[i] - 1].name() + " by "
-              + patches[fixedSync_[pointi] - 1].name()
+                fixedSync_[pointi] > cyclicOwnFixed_[i]
+              ? own + " by " + patches[fixedSync_[pointi] - 1].name()
+              : own + " by itself across the coupling"
             );
             most = max(most, d);
         }
@@ -568,7 +567,8 @@ void Foam::boundaryConstraints::warnCyclicConflicts
             << " that cyclic couplings join (up to " << most << " apart), at"
             << " time " << pMesh_().time().timeName() << ": patches overruled: "
             << names.str().c_str() << ". Each joined set takes the value of"
-            << " the last of its patches in the boundary's order; the cells"
+            << " the last of its patches in the boundary's order (of one"
+            << " patch: the larger value); the cells"
             << " beside the overruled points may fold. Prescribe the coupled"
             << " sides alike" << endl;
     }
